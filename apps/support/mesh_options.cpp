@@ -1,0 +1,52 @@
+#include "apps/support/mesh_options.h"
+
+#include <iostream>
+
+namespace quiver::app {
+
+void MeshOptions::addTo(CLI::App& app, const std::string& meshHelp) {
+  app.add_option("mesh", path, meshHelp)->required();
+  app.add_flag("--fix-orientation", checks.fixOrientation,
+               "Flip inverted tets (with a warning) instead of refusing the mesh");
+  app.add_option("--degenerate-tolerance", checks.degenerateTolerance,
+                 "Refuse tets whose normalised volume 6*sqrt(2)*V/l_rms^3 (1 = regular tet) is below this")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+}
+
+CheckedMesh MeshOptions::load(const std::string& tool) const {
+  CheckedMesh mesh = loadMesh(path, checks);
+  if (!tool.empty())
+    for (const std::string& w : mesh.warnings) std::cerr << tool << ": warning: " << w << "\n";
+  return mesh;
+}
+
+void FixedVertexOptions::addTo(CLI::App& app) {
+  app.add_option("--fix", request.selectors,
+                 "Fix the vertices an expression selects, in mesh units: \"x<0.01\", \"y>=max-1e-3 & z<0.5\", "
+                 "\"box:x0,y0,z0,x1,y1,z1\" (repeatable; union)");
+  app.add_option("--fix-indices", indexList, "Fix vertices by 0-based number in the file's order: \"0,5,10-20\"");
+  app.add_option("--bou", request.bouFiles, "Fix the vertices listed in a Vega .bou file (1-based; repeatable)")
+      ->check(CLI::ExistingFile);
+}
+
+std::vector<int> FixedVertexOptions::select(const CheckedMesh& mesh) {
+  if (!indexList.empty()) request.indices = parseIndexList(indexList, "--fix-indices");
+  return selectFixedVertices(mesh, request);
+}
+
+int runTool(const std::string& tool, CLI::App& app, int argc, char** argv, const std::function<int()>& body) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    return body();
+  } catch (const std::exception& e) {
+    std::cerr << tool << ": error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+} // namespace quiver::app

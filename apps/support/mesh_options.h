@@ -1,0 +1,35 @@
+#pragma once
+// Command-line options shared by the tools that read a mesh, so that every tool spells and
+// documents them the same way.
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "formats/mesh/fixed_vertices.h"
+#include "formats/mesh/mesh_checks.h"
+
+namespace quiver::app {
+
+struct MeshOptions {
+  std::string path;
+  MeshCheckOptions checks;
+
+  // Adds MESH (positional) and --fix-orientation / --degenerate-tolerance.
+  void addTo(CLI::App& app, const std::string& meshHelp = "Tetrahedral mesh (.msh .vtk .vtu .mesh .veg .node/.ele)");
+  // Loads and validates the mesh, printing warnings to stderr as "TOOL: warning: ..." (none when TOOL is "").
+  CheckedMesh load(const std::string& tool) const;
+};
+
+struct FixedVertexOptions {
+  FixedVertexRequest request;
+  std::string indexList;
+
+  // Adds --fix EXPR (repeatable), --fix-indices LIST and --bou FILE (repeatable).
+  void addTo(CLI::App& app);
+  std::vector<int> select(const CheckedMesh& mesh);
+};
+
+// Runs `body`, turning any exception into "TOOL: error: message" on stderr and exit code 1.
+int runTool(const std::string& tool, CLI::App& app, int argc, char** argv, const std::function<int()>& body);
+
+} // namespace quiver::app

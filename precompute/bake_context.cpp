@@ -1,0 +1,61 @@
+#include "precompute/bake_context.h"
+
+#include <cctype>
+#include <iostream>
+#include <stdexcept>
+
+#include <slepcsys.h>
+
+namespace quiver {
+
+namespace {
+bool isPetscOption(const std::string& a) {
+  return a.size() > 2 && a[0] == '-' && a[1] != '-' && std::isalpha(static_cast<unsigned char>(a[1]));
+}
+bool looksLikeOption(const std::string& a) {
+  return a.size() > 1 && a[0] == '-' && !std::isdigit(static_cast<unsigned char>(a[1])) && a[1] != '.';
+}
+} // namespace
+
+void splitPetscOptions(int argc, char** argv, std::vector<std::string>& own, std::vector<std::string>& petsc) {
+  own.assign(1, argv[0]);
+  petsc.assign(1, argv[0]);
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    if (!isPetscOption(a)) {
+      own.push_back(a);
+      continue;
+    }
+    petsc.push_back(a);
+    if (i + 1 < argc && !looksLikeOption(argv[i + 1])) petsc.push_back(argv[++i]);
+  }
+}
+
+BakeContext::BakeContext(std::vector<std::string> petscArgs) : argStorage_(std::move(petscArgs)) {
+  for (auto& a : argStorage_) argv_.push_back(a.data());
+  argv_.push_back(nullptr);
+  int argc = static_cast<int>(argStorage_.size());
+  char** argv = argv_.data();
+  if (SlepcInitialize(&argc, &argv, nullptr, nullptr) != 0) throw std::runtime_error("SLEPc/PETSc initialisation failed");
+  MPI_Comm_rank(comm(), &rank_);
+  MPI_Comm_size(comm(), &size_);
+}
+
+BakeContext::~BakeContext() { SlepcFinalize(); }
+
+void BakeContext::progress(const std::string& message) const {
+  if (rank_ == 0 && !quiet) std::cout << "quiver-bake: " << message << std::endl;
+}
+
+std::string BakeContext::agreeOnError(const std::string& localError) const {
+  int mine = localError.empty() ? size_ : rank_, first = size_;
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm());
+  if (first == size_) return "";
+  int length = static_cast<int>(localError.size());
+  MPI_Bcast(&length, 1, MPI_INT, first, comm());
+  std::string message = rank_ == first ? localError : std::string(length, ' ');
+  MPI_Bcast(message.data(), length, MPI_CHAR, first, comm());
+  return size_ > 1 ? message + " (rank " + std::to_string(first) + ")" : message;
+}
+
+} // namespace quiver
