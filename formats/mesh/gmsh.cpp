@@ -102,7 +102,7 @@ public:
       } else if (section.size() > 1 && section[0] == '$' && section.substr(0, 4) != "$End") {
         skipSection(section);
       } else {
-        cur_.fail("expected a section such as $Nodes, found '" + std::string(section.substr(0, 40)) + "'");
+        cur_.fail("expected a section such as $Nodes, found '" + printableToken(section) + "'");
       }
     }
     if (!sawNodes) cur_.fail("no $Nodes section");
@@ -125,7 +125,7 @@ private:
     else if (v == "4.1")
       version_ = 4;
     else
-      cur_.fail("unsupported Gmsh format version '" + std::string(v.substr(0, 20)) + "' (2.2 and 4.1 are supported)");
+      cur_.fail("unsupported Gmsh format version '" + printableToken(v) + "' (2.2 and 4.1 are supported)");
     binary_ = cur_.integerInRange("file type", 0, 1) == 1;
     sizeT_ = static_cast<int>(cur_.integer("data size"));
     if (sizeT_ != 4 && sizeT_ != 8) cur_.fail("data size " + std::to_string(sizeT_) + " is not 4 or 8");

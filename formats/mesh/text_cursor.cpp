@@ -7,14 +7,14 @@ namespace quiver {
 
 namespace {
 bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v'; }
+} // namespace
 
-std::string printable(std::string_view s) {
+std::string printableToken(std::string_view token) {
   std::string out;
-  for (char c : s.substr(0, 40)) out += (c >= 32 && c < 127) ? c : '?';
-  if (s.size() > 40) out += "...";
+  for (char c : token.substr(0, 40)) out += (c >= 32 && c < 127) ? c : '?';
+  if (token.size() > 40) out += "...";
   return out;
 }
-} // namespace
 
 bool parseInteger(std::string_view s, int64_t& out) {
   if (!s.empty() && s.front() == '+') s.remove_prefix(1);
@@ -75,7 +75,7 @@ std::string_view TextCursor::peekToken() {
 int64_t TextCursor::integer(const char* what) {
   std::string_view t = token(what);
   int64_t v;
-  if (!parseInteger(t, v)) fail(std::string("expected an integer for ") + what + ", found '" + printable(t) + "'");
+  if (!parseInteger(t, v)) fail(std::string("expected an integer for ") + what + ", found '" + printableToken(t) + "'");
   return v;
 }
 
@@ -90,7 +90,7 @@ int64_t TextCursor::integerInRange(const char* what, int64_t lo, int64_t hi) {
 double TextCursor::real(const char* what) {
   std::string_view t = token(what);
   double v;
-  if (!parseReal(t, v)) fail(std::string("expected a number for ") + what + ", found '" + printable(t) + "'");
+  if (!parseReal(t, v)) fail(std::string("expected a number for ") + what + ", found '" + printableToken(t) + "'");
   return v;
 }
 
@@ -103,7 +103,7 @@ double TextCursor::finiteReal(const char* what) {
 void TextCursor::expect(std::string_view keyword) {
   std::string kw(keyword);
   std::string_view t = token(kw.c_str());
-  if (t != keyword) fail("expected '" + kw + "', found '" + printable(t) + "'");
+  if (t != keyword) fail("expected '" + kw + "', found '" + printableToken(t) + "'");
 }
 
 bool TextCursor::atLineEnd() {

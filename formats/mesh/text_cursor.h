@@ -49,6 +49,9 @@ private:
   int tokenLine_ = 1;
 };
 
+// A token from the file made safe for a message: at most 40 characters, non-printable ones as '?'.
+std::string printableToken(std::string_view token);
+
 // Parses a whole string as a number; false when it is not exactly one.
 bool parseInteger(std::string_view s, int64_t& out);
 bool parseReal(std::string_view s, double& out);

@@ -24,13 +24,6 @@ void expectEndOfFile(TextCursor& c, const char* after) {
   if (!c.atEnd()) c.fail("unexpected '" + printableToken(c.token("")) + "' after " + after);
 }
 
-std::string printableToken(std::string_view token) {
-  std::string out;
-  for (char ch : token.substr(0, 40)) out += (ch >= 32 && ch < 127) ? ch : '?';
-  if (token.size() > 40) out += "...";
-  return out;
-}
-
 int readVertexIndex(TextCursor& c, int64_t elementId, int64_t base, int64_t vertexCount) {
   int64_t index = c.integer("vertex index");
   if (index < base || index - base >= vertexCount) failVertexIndex(c.file(), c.line(), elementId, index, base, vertexCount);

@@ -24,9 +24,6 @@ Eigen::Vector3d readPoint(TextCursor& c);
 // Only blanks and comments remain; else "file:line: unexpected 'x' after <after>".
 void expectEndOfFile(TextCursor& c, const char* after);
 
-// A token from the file made safe for a message: at most 40 characters, non-printable ones as '?'.
-std::string printableToken(std::string_view token);
-
 // One vertex reference of element `elementId`, which must lie in [base, base + vertexCount - 1];
 // returns it 0-based. Errors read "file:line: element 12: vertex index 40 is out of range [1, 36]".
 int readVertexIndex(TextCursor& c, int64_t elementId, int64_t base, int64_t vertexCount);

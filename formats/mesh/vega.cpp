@@ -43,7 +43,7 @@ public:
     while (!cur_.atEnd()) {
       std::string_view line = cur_.restOfLine();
       if (line.empty()) continue;
-      if (line[0] != '*') cur_.fail("expected a *KEYWORD line, found '" + std::string(line.substr(0, 40)) + "'");
+      if (line[0] != '*') cur_.fail("expected a *KEYWORD line, found '" + printableToken(line) + "'");
       std::string_view keyword = line.substr(0, line.find_first_of(" \t"));
       std::string argument = trim(line.substr(keyword.size()));
       if (keyword == "*VERTICES")
@@ -59,7 +59,7 @@ public:
       else if (keyword == "*INCLUDE")
         cur_.fail("*INCLUDE is not supported: merge the included file into this one");
       else
-        cur_.fail("unknown keyword '" + std::string(keyword.substr(0, 40)) + "'");
+        cur_.fail("unknown keyword '" + printableToken(keyword) + "'");
     }
     if (!sawVertices_) cur_.fail("no *VERTICES section");
     if (!sawElements_) cur_.fail("no *ELEMENTS section");
@@ -90,7 +90,7 @@ private:
     sawElements_ = true;
     std::string_view type = cur_.token("element type");
     if (type != "TET" && type != "TETS")
-      cur_.fail("element type '" + std::string(type.substr(0, 20)) + "' is not supported (only TET)");
+      cur_.fail("element type '" + printableToken(type) + "' is not supported (only TET)");
     int64_t n = cur_.count("element count", 10);
     cur_.integerInRange("vertices per element", 4, 4);
     cur_.restOfLine();
@@ -109,13 +109,13 @@ private:
   void readMaterial(const std::string& name) {
     if (name.empty()) cur_.fail("*MATERIAL needs a name");
     std::vector<std::string> f = commaFields(cur_.restOfLine());
-    if (f[0] != "ENU") cur_.fail("material type '" + f[0].substr(0, 20) + "' is not supported (only ENU)");
+    if (f[0] != "ENU") cur_.fail("material type '" + printableToken(f[0]) + "' is not supported (only ENU)");
     if (f.size() != 4) cur_.fail("ENU material needs 'ENU, density, E, nu'");
     Material m;
     m.name = name;
     double* slots[3] = {&m.density, &m.youngsModulus, &m.poissonRatio};
     for (int k = 0; k < 3; ++k)
-      if (!parseReal(f[k + 1], *slots[k])) cur_.fail("material '" + name + "': '" + f[k + 1].substr(0, 20) + "' is not a number");
+      if (!parseReal(f[k + 1], *slots[k])) cur_.fail("material '" + name + "': '" + printableToken(f[k + 1]) + "' is not a number");
     std::string bad = checkMaterial(m);
     if (!bad.empty()) cur_.fail("material '" + name + "': " + bad);
     if (!materialIndex_.emplace(name, static_cast<int>(out_.mesh.materials.size())).second)
@@ -131,7 +131,7 @@ private:
       for (const std::string& field : commaFields(cur_.restOfLine())) {
         if (field.empty()) continue;
         int64_t e;
-        if (!parseInteger(field, e)) cur_.fail("set '" + name + "': '" + field.substr(0, 20) + "' is not an element number");
+        if (!parseInteger(field, e)) cur_.fail("set '" + name + "': '" + printableToken(field) + "' is not an element number");
         if (e < 1 || e > out_.mesh.tetCount())
           cur_.fail("set '" + name + "': element " + std::to_string(e) + " is out of range [1, " +
                     std::to_string(out_.mesh.tetCount()) + "]");
@@ -217,7 +217,7 @@ std::vector<int> parseBou(std::string_view bytes, const std::string& file, int v
         start = end == std::string::npos ? field.size() : end + 1;
         if (word.empty()) continue;
         int64_t v;
-        if (!parseInteger(word, v)) cur.fail("'" + std::string(word.substr(0, 20)) + "' is not a vertex number");
+        if (!parseInteger(word, v)) cur.fail("'" + printableToken(word) + "' is not a vertex number");
         if (v < 1 || v > vertexCount)
           cur.fail("vertex " + std::to_string(v) + " is out of range [1, " + std::to_string(vertexCount) + "] (.bou files are 1-based)");
         out.push_back(static_cast<int>(v - 1));
