@@ -7,19 +7,6 @@
 
 namespace quiver {
 
-Eigen::Matrix3d greenStrain(const Eigen::Matrix3d& F) {
-  return 0.5 * (F.transpose() * F - Eigen::Matrix3d::Identity());
-}
-
-Eigen::Matrix3d stvkSecondPiolaKirchhoff(const Eigen::Matrix3d& E, double lambda, double mu) {
-  return 2 * mu * E + lambda * E.trace() * Eigen::Matrix3d::Identity();
-}
-
-double stvkEnergyDensity(const Eigen::Matrix3d& E, double lambda, double mu) {
-  const double trace = E.trace();
-  return mu * E.squaredNorm() + 0.5 * lambda * trace * trace;
-}
-
 StVKForceModel::StVKForceModel(const TetMesh& mesh, const std::vector<Material>& perTet)
     : vertexCount_(mesh.vertexCount()), tets_(mesh.tets), elements_(computeTetElements(mesh)) {
   if (static_cast<int>(perTet.size()) != mesh.tetCount())
@@ -96,9 +83,20 @@ void StVKForceModel::internalForce(const Eigen::VectorXd& u, Eigen::VectorXd& f)
   for (size_t t = 0; t < tets_.size(); ++t) {
     const Matrix34& G = elements_.gradients[t];
     const Eigen::Matrix3d F = deformationGradient(tetDisplacements(tets_[t], u), G);
-    const Eigen::Matrix3d P = F * stvkSecondPiolaKirchhoff(greenStrain(F), lambda_[t], mu_[t]);
-    const Matrix34 fe = elements_.volume[t] * P * G;
+    const Matrix34 fe = stvkElementForce(F, G, elements_.volume[t], lambda_[t], mu_[t]);
     for (int a = 0; a < 4; ++a) f.segment<3>(3 * tets_[t][a]) += fe.col(a);
+  }
+}
+
+void StVKForceModel::forceHessianAtRest(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                                        Eigen::VectorXd& out) const {
+  checkSize(a);
+  checkSize(b);
+  out.setZero(dofCount());
+  for (size_t t = 0; t < tets_.size(); ++t) {
+    const Matrix34 fe = stvkElementForceHessianAtRest(tetDisplacements(tets_[t], a), tetDisplacements(tets_[t], b),
+                                                      elements_.gradients[t], elements_.volume[t], lambda_[t], mu_[t]);
+    for (int c = 0; c < 4; ++c) out.segment<3>(3 * tets_[t][c]) += fe.col(c);
   }
 }
 
@@ -116,26 +114,10 @@ void StVKForceModel::tangentStiffness(const Eigen::VectorXd& u, Eigen::SparseMat
   double* values = K.valuePtr();
   std::fill(values, values + K.nonZeros(), 0.0);
 
-  Eigen::Matrix<double, 12, 12> Ke;
   for (size_t t = 0; t < tets_.size(); ++t) {
     const Matrix34& G = elements_.gradients[t];
-    const double V = elements_.volume[t], lambda = lambda_[t], mu = mu_[t];
     const Eigen::Matrix3d F = deformationGradient(tetDisplacements(tets_[t], u), G);
-    const Eigen::Matrix3d S = stvkSecondPiolaKirchhoff(greenStrain(F), lambda, mu);
-    // Differentiating V P g_a = V F S g_a along u_b gives a geometric term (S fixed, F moves)
-    // and a material term (S moves with E); both reduce to these small products.
-    const Eigen::Matrix4d GSG = G.transpose() * S * G;
-    const Eigen::Matrix4d GG = G.transpose() * G;
-    const Eigen::Matrix3d B = F * F.transpose();
-    const Matrix34 A = F * G; // column a: F g_a
-    for (int a = 0; a < 4; ++a)
-      for (int b = a; b < 4; ++b) {
-        const Eigen::Matrix3d block =
-            V * (GSG(a, b) * Eigen::Matrix3d::Identity() + mu * GG(a, b) * B + mu * A.col(b) * A.col(a).transpose() +
-                 lambda * A.col(a) * A.col(b).transpose());
-        Ke.block<3, 3>(3 * a, 3 * b) = block;
-        if (b != a) Ke.block<3, 3>(3 * b, 3 * a) = block.transpose();
-      }
+    const Matrix12 Ke = stvkElementTangent(F, G, elements_.volume[t], lambda_[t], mu_[t]);
     const int* slot = &slots_[144 * t];
     for (int k = 0; k < 144; ++k) values[slot[k]] += Ke.data()[k];
   }

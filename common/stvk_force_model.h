@@ -11,19 +11,11 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include "common/stvk_element.h"
 #include "common/tet_elements.h"
 #include "common/tet_mesh.h"
 
 namespace quiver {
-
-// Green strain E = \tfrac12 (F^T F - I).
-Eigen::Matrix3d greenStrain(const Eigen::Matrix3d& F);
-
-// StVK second Piola-Kirchhoff stress S = \partial W / \partial E = 2 \mu E + \lambda \operatorname{tr}(E) I.
-Eigen::Matrix3d stvkSecondPiolaKirchhoff(const Eigen::Matrix3d& E, double lambda, double mu);
-
-// StVK energy density W = \mu E:E + \tfrac{\lambda}{2} (\operatorname{tr} E)^2, per unit rest volume.
-double stvkEnergyDensity(const Eigen::Matrix3d& E, double lambda, double mu);
 
 // The full-space StVK model of one mesh. Immutable after construction, so one instance can
 // serve several threads; it keeps its own copy of the connectivity, not a reference to the mesh.
@@ -52,12 +44,16 @@ public:
   // `f` is resized to dofCount() (no allocation when it already has that size).
   void internalForce(const Eigen::VectorXd& u, Eigen::VectorXd& f) const;
 
+  // Second derivative of R at rest along displacements a and b, \partial_s \partial_t R(s a + t b) at
+  // s = t = 0 (= the derivative of K at rest along b, applied to a): the right-hand side of the
+  // modal derivatives K \Psi_{ij} = -d^2R[\phi_i, \phi_j]. Tet e contributes
+  // stvkElementForceHessianAtRest(). `out` is resized to dofCount().
+  void forceHessianAtRest(const Eigen::VectorXd& a, const Eigen::VectorXd& b, Eigen::VectorXd& out) const;
+
   // Tangent stiffness K(u) = \partial R / \partial u, symmetric, stored in full (both triangles)
   // on the fixed pattern of all vertex pairs that share a tet. K(0) is linear elasticity; under
   // large compression K(u) can be indefinite.
-  // Tet e's block for vertices (a, b) is
-  //   K_e^{ab} = V_e [ (g_a^T S g_b) I + \mu (g_a \cdot g_b) F F^T + \mu F g_b (F g_a)^T
-  //                    + \lambda F g_a (F g_b)^T ].
+  // Tet e contributes stvkElementTangent().
   Eigen::SparseMatrix<double> tangentStiffness(const Eigen::VectorXd& u) const;
 
   // Same, refilling `K` in place. When K already has this model's pattern (it was returned by

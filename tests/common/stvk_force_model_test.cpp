@@ -170,6 +170,36 @@ INSTANTIATE_TEST_SUITE_P(Meshes, TangentStiffness, ::testing::Bool(),
                            return std::string(p.param ? "JitteredTwoMaterials" : "Box");
                          });
 
+// K(u) is quadratic in u, so the central difference of K along b is exact up to round-off:
+// d^2R[a, b] = (K(eps b) - K(-eps b)) a / (2 eps). A second check differentiates the force twice.
+TEST(StVKForceModel, ForceHessianAtRestIsTheDerivativeOfTheTangent) {
+  std::mt19937 rng(11);
+  Body body = jitteredTwoMaterialBody(rng);
+  StVKForceModel model(body.mesh, body.perTet);
+  const int n = model.dofCount();
+  const Eigen::VectorXd a = randomDisplacement(n, 0.1, rng), b = randomDisplacement(n, 0.1, rng);
+  Eigen::VectorXd ab, ba;
+  model.forceHessianAtRest(a, b, ab);
+  model.forceHessianAtRest(b, a, ba);
+  const double eps = 1e-3;
+  const Eigen::VectorXd fromTangent = (model.tangentStiffness(eps * b) - model.tangentStiffness(-eps * b)) * a / (2 * eps);
+  const double tangentError = (ab - fromTangent).norm() / fromTangent.norm();
+  EXPECT_LT(tangentError, 1e-10);
+  EXPECT_LT((ab - ba).norm(), 1e-13 * ab.norm());
+
+  Eigen::VectorXd fpp, fpm, fmp, fmm;
+  const double h = 1e-3;
+  model.internalForce(h * (a + b), fpp);
+  model.internalForce(h * (a - b), fpm);
+  model.internalForce(h * (b - a), fmp);
+  model.internalForce(-h * (a + b), fmm);
+  const Eigen::VectorXd fromForce = (fpp - fpm - fmp + fmm) / (4 * h * h);
+  const double forceError = (ab - fromForce).norm() / fromForce.norm();
+  EXPECT_LT(forceError, 1e-6);
+  RecordProperty("hessian_vs_tangent_fd", sci(tangentError));
+  RecordProperty("hessian_vs_force_fd", sci(forceError));
+}
+
 TEST(StVKForceModel, RestStiffnessHasExactlySixRigidModes) {
   std::mt19937 rng(4);
   const Body body = jitteredTwoMaterialBody(rng);
