@@ -125,12 +125,16 @@ RawMesh LegacyReader::read() {
 DataType LegacyReader::dataType() {
   std::string name(text_.token("data type"));
   for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  // VTK's names; the sized vtktype* names other than the 64-bit ones are meshio's (for OFFSETS/CONNECTIVITY).
   static const std::pair<const char*, Scalar> kNames[] = {
-      {"char", Scalar::Int8},          {"signed_char", Scalar::Int8},   {"unsigned_char", Scalar::UInt8},
-      {"short", Scalar::Int16},        {"unsigned_short", Scalar::UInt16}, {"int", Scalar::Int32},
-      {"unsigned_int", Scalar::UInt32}, {"vtkidtype", Scalar::Int32},  // VTK writes vtkIdType as int
-      {"long", Scalar::Int64},         {"unsigned_long", Scalar::UInt64}, {"vtktypeint64", Scalar::Int64},
-      {"vtktypeuint64", Scalar::UInt64}, {"float", Scalar::Float32},  {"double", Scalar::Float64},
+      {"char", Scalar::Int8},           {"signed_char", Scalar::Int8},      {"unsigned_char", Scalar::UInt8},
+      {"short", Scalar::Int16},         {"unsigned_short", Scalar::UInt16}, {"int", Scalar::Int32},
+      {"unsigned_int", Scalar::UInt32}, {"long", Scalar::Int64},            {"unsigned_long", Scalar::UInt64},
+      {"float", Scalar::Float32},       {"double", Scalar::Float64},
+      {"vtkidtype", Scalar::Int32},  // VTK writes vtkIdType arrays as int
+      {"vtktypeint8", Scalar::Int8},    {"vtktypeuint8", Scalar::UInt8},    {"vtktypeint16", Scalar::Int16},
+      {"vtktypeuint16", Scalar::UInt16}, {"vtktypeint32", Scalar::Int32},   {"vtktypeuint32", Scalar::UInt32},
+      {"vtktypeint64", Scalar::Int64},  {"vtktypeuint64", Scalar::UInt64},
   };
   for (const auto& [n, scalar] : kNames)
     if (name == n) return {DataType::Number, scalar};
@@ -177,8 +181,10 @@ void LegacyReader::readClassicCells(int64_t cellCount, int64_t listSize) {
       return;
     }
     const int64_t cell = static_cast<int64_t>(cells_.positions.size());
-    if (cell == cellCount) failAt(position, "the cell list holds more than the " + std::to_string(cellCount) + " cells CELLS declares");
-    if (v < 0 || v > listSize) failAt(position, "cell " + std::to_string(cell) + ": point count " + std::to_string(v) + " is invalid");
+    if (cell == cellCount)
+      failAt(position, "the cell list holds more than the " + std::to_string(cellCount) + " cells CELLS declares");
+    if (v < 0 || v > listSize)
+      failAt(position, "cell " + std::to_string(cell) + ": point count " + std::to_string(v) + " is invalid");
     cells_.positions.push_back(position);
     pending = v;
     if (v == 0) cells_.offsets.push_back(static_cast<int64_t>(cells_.connectivity.size()));
@@ -349,7 +355,8 @@ void LegacyReader::skipValues(int64_t n, DataType type, const std::string& what)
     return;
   }
   if (type.kind == DataType::String) text_.fail("string arrays in BINARY files are not supported ('" + what + "')");
-  const int64_t bytes = type.kind == DataType::Bit ? (n + 7) / 8 : n * static_cast<int64_t>(vtk::scalarBytes(type.scalar));
+  const int64_t bytes =
+      type.kind == DataType::Bit ? (n + 7) / 8 : n * static_cast<int64_t>(vtk::scalarBytes(type.scalar));
   checkFits(bytes, 1, what);
   text_.seek(beginBinary() + static_cast<size_t>(bytes));
 }

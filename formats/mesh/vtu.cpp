@@ -7,8 +7,6 @@
 
 #include <algorithm>
 #include <climits>
-#include <cmath>
-#include <cstring>
 #include <type_traits>
 
 #include "formats/mesh/read_mesh.h"
@@ -130,7 +128,8 @@ std::string_view arrayBytes(const VtuFile& f, Payload& p, uint64_t expectedBytes
     return p.prefix(w + size).substr(w);
   }
   const uint64_t blocks = p.word(0, f);
-  if (blocks > p.capacity() / w) p.fail("compression header declares " + std::to_string(blocks) + " blocks, more than the data holds");
+  if (blocks > p.capacity() / w)
+    p.fail("compression header declares " + std::to_string(blocks) + " blocks, more than the data holds");
   const uint64_t blockSize = p.word(1, f), lastSize = p.word(2, f);
   const uint64_t headerSize = (3 + blocks) * w;
   p.prefix(headerSize);
@@ -139,7 +138,8 @@ std::string_view arrayBytes(const VtuFile& f, Payload& p, uint64_t expectedBytes
            std::to_string(lastSize));
   const auto uncompressedSize = [&](uint64_t b) { return b + 1 < blocks || lastSize == 0 ? blockSize : lastSize; };
   // The uncompressed total, unless it is larger than the array (it may not even fit in 64 bits).
-  const bool tooLarge = blocks > 0 && (blocks - 1 > expectedBytes / blockSize || uncompressedSize(blocks - 1) > expectedBytes);
+  const bool tooLarge =
+      blocks > 0 && (blocks - 1 > expectedBytes / blockSize || uncompressedSize(blocks - 1) > expectedBytes);
   const uint64_t total = blocks == 0 || tooLarge ? 0 : (blocks - 1) * blockSize + uncompressedSize(blocks - 1);
   if (tooLarge || total != expectedBytes)
     p.fail("compression header declares " + std::to_string(blocks) + " blocks of " + std::to_string(blockSize) +
@@ -185,7 +185,8 @@ std::vector<T> asciiValues(const char* text, int64_t expected, const VtuFile& f,
     const size_t start = i;
     while (i < s.size() && !isBlank(s[i])) ++i;
     const std::string_view token = s.substr(start, i - start);
-    if (static_cast<int64_t>(out.size()) == expected) fail(f, array, "holds more than the " + std::to_string(expected) + " values expected");
+    if (static_cast<int64_t>(out.size()) == expected)
+      fail(f, array, "holds more than the " + std::to_string(expected) + " values expected");
     T v;
     bool ok;
     if constexpr (std::is_same_v<T, double>) ok = parseReal(token, v);
@@ -197,7 +198,8 @@ std::vector<T> asciiValues(const char* text, int64_t expected, const VtuFile& f,
     out.push_back(v);
   }
   if (static_cast<int64_t>(out.size()) != expected)
-    fail(f, array, "holds " + std::to_string(out.size()) + " values, expected " + std::to_string(expected) + " (truncated?)");
+    fail(f, array,
+         "holds " + std::to_string(out.size()) + " values, expected " + std::to_string(expected) + " (truncated?)");
   return out;
 }
 
@@ -208,7 +210,8 @@ std::vector<T> readDataArray(const VtuFile& f, const XMLElement* array, int64_t 
   const char* typeName = array->Attribute("type");
   if (!typeName || !vtk::parseXmlScalar(typeName, type))
     fail(f, array, std::string("unsupported type '") + (typeName ? typeName : "") + "'");
-  if (std::is_same_v<T, int64_t> && vtk::isFloating(type)) fail(f, array, std::string("needs an integer type, not ") + typeName);
+  if (std::is_same_v<T, int64_t> && vtk::isFloating(type))
+    fail(f, array, std::string("needs an integer type, not ") + typeName);
   if (expected > INT64_MAX / 8) fail(f, array, "declares " + std::to_string(expected) + " values, too many");
   const std::string format = array->Attribute("format") ? array->Attribute("format") : "";
   if (format == "ascii") return asciiValues<T>(array->GetText(), expected, f, array);
@@ -233,7 +236,8 @@ std::vector<T> readDataArray(const VtuFile& f, const XMLElement* array, int64_t 
   }
   Payload payload(data, base64, describe(f, array), fileOffset);
   std::string inflated;
-  const std::string_view bytes = arrayBytes(f, payload, static_cast<uint64_t>(expected) * vtk::scalarBytes(type), inflated);
+  const std::string_view bytes =
+      arrayBytes(f, payload, static_cast<uint64_t>(expected) * vtk::scalarBytes(type), inflated);
   ByteCursor in(bytes, 0, describe(f, array), f.swap);
   std::vector<T> out;
   out.reserve(static_cast<size_t>(expected));
@@ -271,7 +275,8 @@ void readPiece(const VtuFile& f, const XMLElement* piece, RawMesh& out, vtk::Tet
   if (points < 0 || cells < 0) fail(f, piece, "needs NumberOfPoints and NumberOfCells");
 
   const XMLElement* pointArray = child(f, child(f, piece, "Points"), "DataArray");
-  if (intAttribute(f, pointArray, "NumberOfComponents", 1, INT_MAX) != 3) fail(f, pointArray, "needs NumberOfComponents=\"3\"");
+  if (intAttribute(f, pointArray, "NumberOfComponents", 1, INT_MAX) != 3)
+    fail(f, pointArray, "needs NumberOfComponents=\"3\"");
   const std::vector<double> xyz = readDataArray<double>(f, pointArray, 3 * points);
   for (int64_t i = 0; i < points; ++i) {
     const Eigen::Vector3d x(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
@@ -317,7 +322,8 @@ void readPiece(const VtuFile& f, const XMLElement* piece, RawMesh& out, vtk::Tet
 // Raw appended data is not XML: finds <AppendedData encoding="..."> and the bytes after its '_'.
 void locateAppendedData(std::string_view bytes, size_t tagStart, VtuFile& f) {
   const size_t tagEnd = bytes.find('>', tagStart);
-  if (tagEnd == std::string_view::npos) throw MeshError(f.file + ": byte " + std::to_string(tagStart) + ": unterminated <AppendedData> tag");
+  if (tagEnd == std::string_view::npos)
+    throw MeshError(f.file + ": byte " + std::to_string(tagStart) + ": unterminated <AppendedData> tag");
   std::string tag(bytes.substr(tagStart, tagEnd - tagStart));
   if (tag.back() == '/') return;  // <AppendedData/>: nothing appended
   tag += "/>";
@@ -326,7 +332,8 @@ void locateAppendedData(std::string_view bytes, size_t tagStart, VtuFile& f) {
                              ? doc.RootElement()->Attribute("encoding") : nullptr;
   const std::string enc = encoding ? encoding : "";
   if (enc != "raw" && enc != "base64")
-    throw MeshError(f.file + ": byte " + std::to_string(tagStart) + ": <AppendedData> needs encoding=\"raw\" or \"base64\"");
+    throw MeshError(f.file + ": byte " + std::to_string(tagStart) +
+                    ": <AppendedData> needs encoding=\"raw\" or \"base64\"");
   size_t start = tagEnd + 1;
   while (start < bytes.size() && isBlank(bytes[start])) ++start;
   if (start == bytes.size() || bytes[start] != '_')

@@ -114,7 +114,8 @@ TEST(VtkLegacyRead, SampleKeepsTetsAndSkipsEverythingElse) {
 
 TEST(VtkLegacyRead, RegionFromFieldArrayAndNoRegion) {
   // meshio writes cell data as FIELD arrays.
-  std::string text = kMinimal + "CELL_DATA 1\nFIELD FieldData 2\ngmsh:geometrical 1 1 int\n5\ngmsh:physical 1 1 int\n42\n";
+  std::string text =
+      kMinimal + "CELL_DATA 1\nFIELD FieldData 2\ngmsh:geometrical 1 1 int\n5\ngmsh:physical 1 1 int\n42\n";
   EXPECT_EQ(parseVtkLegacy(text, "field.vtk").mesh.tetRegion, (std::vector<int>{42}));
   EXPECT_EQ(parseVtkLegacy(kMinimal, "plain.vtk").mesh.tetRegion, (std::vector<int>{0}));
   // A region-named array of floats cannot give regions: ignored, with a warning.
@@ -136,7 +137,7 @@ POINTS 6 double
 CELLS 4 11
 OFFSETS vtktypeint64
 0 4 7 11
-CONNECTIVITY vtktypeint64
+CONNECTIVITY vtktypeint32
 0 1 2 3 0 1 2
 1 2 3 4
 CELL_TYPES 3
@@ -155,7 +156,8 @@ LOOKUP_TABLE default
   EXPECT_EQ(raw.report.skippedCells, 1);
 
   expectErrorAt(errorOf(replaced(text, "0 4 7 11", "0 4 3 11")), "bad.vtk", lineOf(text, "0 4 7 11"), "cell offset 3");
-  expectErrorAt(errorOf(replaced(text, "0 4 7 11", "0 4 7 10")), "bad.vtk", lineOf(text, "0 4 7 11"), "last cell offset");
+  expectErrorAt(errorOf(replaced(text, "0 4 7 11", "0 4 7 10")), "bad.vtk", lineOf(text, "0 4 7 11"),
+                "last cell offset");
   const std::string bad = replaced(text, "1 2 3 4\n", "1 2 3 6\n");
   expectErrorAt(errorOf(bad), "bad.vtk", lineOf(bad, "1 2 3 6"), "cell 2: point index 6 is out of range [0, 6)");
 }
@@ -183,10 +185,10 @@ std::string binarySample(bool vtk51, std::vector<int64_t>& cellOffsets) {
   if (vtk51) {
     w.bytes += "\nCELLS 4 11\nOFFSETS vtktypeint64\n";
     for (int64_t o : {0, 4, 7, 11}) w.put(o);
-    w.bytes += "\nCONNECTIVITY vtktypeint64\n";
+    w.bytes += "\nCONNECTIVITY vtktypeint32\n";  // meshio's name for 32-bit connectivity
     for (const auto& cell : cells) {
       cellOffsets.push_back(static_cast<int64_t>(w.bytes.size()));
-      for (int v : cell) w.put(static_cast<int64_t>(v));
+      for (int v : cell) w.put(static_cast<int32_t>(v));
     }
   } else {
     w.bytes += "\nCELLS 3 14\n";
@@ -225,7 +227,7 @@ TEST(VtkLegacyRead, BinaryBigEndianClassicAnd51Layouts) {
 
     // The last point index of the last cell out of range: named by the cell's byte offset.
     std::string bad = bytes;
-    const size_t indexSize = vtk51 ? 8 : 4, lastIndex = static_cast<size_t>(cellOffsets[2]) + (vtk51 ? 3 : 4) * indexSize;
+    const size_t indexSize = 4, lastIndex = static_cast<size_t>(cellOffsets[2]) + (vtk51 ? 3 : 4) * indexSize;
     bad[lastIndex + indexSize - 1] = 9;
     std::string message = meshErrorOf([&] { parseVtkLegacy(bad, "bad.vtk"); });
     EXPECT_NE(message.find("bad.vtk: byte " + std::to_string(cellOffsets[2]) + ": cell 2: point index 9"),
@@ -247,7 +249,8 @@ TEST(VtkLegacyRead, BinaryBigEndianClassicAnd51Layouts) {
     nanBytes.put(nan);
     bad.replace(pointsStart + 7 * 4, 4, nanBytes.bytes);
     message = meshErrorOf([&] { parseVtkLegacy(bad, "nan.vtk"); });
-    EXPECT_NE(message.find("nan.vtk: byte " + std::to_string(pointsStart + 28) + ": point 2"), std::string::npos) << message;
+    EXPECT_NE(message.find("nan.vtk: byte " + std::to_string(pointsStart + 28) + ": point 2"), std::string::npos)
+        << message;
   }
 }
 
@@ -312,7 +315,8 @@ TEST(VtkLegacyWrite, RoundTripIsBitExact) {
 
   TetMesh noRegions = mesh;
   noRegions.tetRegion.clear();
-  EXPECT_EQ(parseVtkLegacy(formatVtkLegacy(noRegions), "plain.vtk").mesh.tetRegion, std::vector<int>(mesh.tetCount(), 0));
+  EXPECT_EQ(parseVtkLegacy(formatVtkLegacy(noRegions), "plain.vtk").mesh.tetRegion,
+            std::vector<int>(mesh.tetCount(), 0));
   EXPECT_THROW(formatVtkLegacy(mesh, {{"two words", displacement.values}}), MeshError);
   EXPECT_THROW(formatVtkLegacy(mesh, {{"short", {Eigen::Vector3d::Zero()}}}), MeshError);
 }
@@ -357,7 +361,8 @@ TEST(VtkLegacyBadInput, InconsistentOrUnsupported) {
   EXPECT_EQ(parseVtkLegacy(text, "hex.vtk").mesh.tetCount(), 0);  // a 4-point "hexahedron" is skipped, not read
   text = replaced(kMinimal, "CELLS 1 5\n4 0 1 2 3", "CELLS 1 4\n3 0 1 2");
   expectErrorAt(errorOf(text), "bad.vtk", lineOf(text, "3 0 1 2"), "VTK_TETRA cell has 3 points");
-  expectErrorAt(errorOf(replaced(kMinimal, "UNSTRUCTURED_GRID", "POLYDATA")), "bad.vtk", 4, "only DATASET UNSTRUCTURED_GRID");
+  expectErrorAt(errorOf(replaced(kMinimal, "UNSTRUCTURED_GRID", "POLYDATA")), "bad.vtk", 4,
+                "only DATASET UNSTRUCTURED_GRID");
   expectErrorAt(errorOf(replaced(kMinimal, "ASCII", "TEXT")), "bad.vtk", 3, "expected ASCII or BINARY");
   expectErrorAt(errorOf(replaced(kMinimal, "# vtk", "# VTK")), "bad.vtk", 1, "not a VTK legacy file");
   text = kMinimal + "SCALARS s float\n1\n";

@@ -66,7 +66,8 @@ std::string errorOf(const std::string& text) {
 
 // `message` contains each of `parts`.
 void expectMessage(const std::string& message, std::initializer_list<std::string> parts) {
-  for (const std::string& part : parts) EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' not in '" << message << "'";
+  for (const std::string &part : parts)
+    EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' not in '" << message << "'";
 }
 
 TEST(VtuRead, AsciiPiecesAreConcatenated) {
@@ -150,11 +151,12 @@ public:
   }
 
   std::string file(const std::string& piece) const {
-    std::string s = std::string("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"") +
-                    (layout_.bigEndian ? "BigEndian" : "LittleEndian") + "\" header_type=\"" +
-                    (layout_.header64 ? "UInt64" : "UInt32") + "\"" +
-                    (layout_.compressed ? " compressor=\"vtkZLibDataCompressor\"" : "") +
-                    ">\n<UnstructuredGrid>\n" + piece + "</UnstructuredGrid>\n";
+    std::string s =
+        std::string("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"") +
+        (layout_.bigEndian ? "BigEndian" : "LittleEndian") + "\" header_type=\"" +
+        (layout_.header64 ? "UInt64" : "UInt32") + "\"" +
+        (layout_.compressed ? " compressor=\"vtkZLibDataCompressor\"" : "") + ">\n<UnstructuredGrid>\n" + piece +
+        "</UnstructuredGrid>\n";
     if (layout_.placement != Placement::Inline)
       s += std::string("<AppendedData encoding=\"") + (layout_.placement == Placement::AppendedRaw ? "raw" : "base64") +
            "\">\n  _" + appended_ + "\n</AppendedData>\n";
@@ -179,7 +181,8 @@ private:
 // Six points; a tet, a triangle and a tet, with regions -4, 5, 600 and a point array to skip.
 const std::vector<double> kPoints = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.1, 0.2, 0.3, -1e-300, 7, 1e10};
 
-std::string binaryFile(const Layout& layout, const std::vector<int32_t>& connectivity = {0, 1, 2, 3, 4, 2, 1, 2, 3, 5}) {
+std::string binaryFile(const Layout &layout,
+                       const std::vector<int32_t> &connectivity = {0, 1, 2, 3, 4, 2, 1, 2, 3, 5}) {
   VtuBuilder b(layout);
   std::string piece = "<Piece NumberOfPoints=\"6\" NumberOfCells=\"3\">\n<PointData>\n";
   piece += b.array("Float32", "u", 3, std::vector<float>(18, 0.5f));
@@ -295,7 +298,8 @@ TEST(VtuBadInput, AsciiValues) {
   const int pointsLine = lineOf(kAscii, "NumberOfComponents=\"3\"");
   const std::string where = "bad.vtu:" + std::to_string(pointsLine) + ": DataArray (in Points): ";
   expectMessage(errorOf(replaced(kAscii, "0.1 0.2 0.3", "0.1 nan 0.3")), {where + "point 4: coordinate is not finite"});
-  expectMessage(errorOf(replaced(kAscii, "0.1 0.2 0.3", "0.1 abc 0.3")), {where + "value 13: expected a number, found 'abc'"});
+  expectMessage(errorOf(replaced(kAscii, "0.1 0.2 0.3", "0.1 abc 0.3")),
+                {where + "value 13: expected a number, found 'abc'"});
   expectMessage(errorOf(replaced(kAscii, "0.1 0.2 0.3", "0.1 0.2")), {where + "holds 14 values, expected 15"});
   expectMessage(errorOf(replaced(kAscii, "0.1 0.2 0.3", "0.1 0.2 0.3 4")), {where + "holds more than the 15 values"});
   expectMessage(errorOf(replaced(kAscii, "NumberOfPoints=\"5\"", "NumberOfPoints=\"100000000\"")),
@@ -303,18 +307,21 @@ TEST(VtuBadInput, AsciiValues) {
   expectMessage(errorOf(replaced(kAscii, "0 1 2 3 4 1 2", "0 1 2 3 4 1 x")),
                 {"DataArray 'connectivity': value 6: expected an integer, found 'x'"});
   expectMessage(errorOf(replaced(kAscii, ">4 7<", ">4 3<")), {"DataArray 'offsets': cell 1: offset 3 is less than"});
-  expectMessage(errorOf(replaced(kAscii, ">0 1 2 3<", ">0 1 2 4<")), {"DataArray 'connectivity': cell 2: point index 4"});
+  expectMessage(errorOf(replaced(kAscii, ">0 1 2 3<", ">0 1 2 4<")),
+                {"DataArray 'connectivity': cell 2: point index 4"});
   expectMessage(errorOf(replaced(kAscii, "type=\"Int32\" Name=\"offsets\"", "type=\"Float32\" Name=\"offsets\"")),
                 {"DataArray 'offsets': needs an integer type, not Float32"});
   test::expectEveryCutFails(kAscii, "cut.vtu", [](std::string_view text) { parseVtu(text, "cut.vtu"); });
 }
 
 TEST(VtuBadInput, UnsupportedFiles) {
-  expectMessage(errorOf(replaced(kAscii, "UnstructuredGrid\" version", "PolyData\" version")), {"bad.vtu", "UnstructuredGrid"});
+  expectMessage(errorOf(replaced(kAscii, "UnstructuredGrid\" version", "PolyData\" version")),
+                {"bad.vtu", "UnstructuredGrid"});
   expectMessage(errorOf(replaced(kAscii, "byte_order=\"LittleEndian\"", "compressor=\"vtkLZ4DataCompressor\"")),
                 {"bad.vtu:2: VTKFile: unsupported compressor 'vtkLZ4DataCompressor'"});
   expectMessage(errorOf("<VTKFile><UnstructuredGrid>"), {"bad.vtu:", "not valid XML"});
-  expectMessage(errorOf(replaced(kAscii, "format=\"ascii\">0 1 2 3 4", "format=\"hex\">0 1 2 3 4")), {"unknown format 'hex'"});
+  expectMessage(errorOf(replaced(kAscii, "format=\"ascii\">0 1 2 3 4", "format=\"hex\">0 1 2 3 4")),
+                {"unknown format 'hex'"});
 }
 
 // ---- Writer ----------------------------------------------------------------------------------
@@ -362,7 +369,8 @@ TEST(VtuWrite, RoundTripIsBitExact) {
     for (const PointField* field : {&displacement, &velocity}) {
       const std::vector<double> values = arrayDoubles(text, field->name, 3 * field->values.size());
       for (size_t v = 0; v < field->values.size(); ++v)
-        EXPECT_EQ(std::memcmp(&values[3 * v], field->values[v].data(), 3 * sizeof(double)), 0) << field->name << " " << v;
+        EXPECT_EQ(std::memcmp(&values[3 * v], field->values[v].data(), 3 * sizeof(double)), 0)
+            << field->name << " " << v;
     }
     TetMesh noRegions = mesh;
     noRegions.tetRegion.clear();
