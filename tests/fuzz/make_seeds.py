@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Writes the fuzzers' seed corpus (tests/fuzz/seeds/<format>/) from one tiny box mesh, in every
-encoding meshio can produce, plus hand-written Vega, MFEM and .bou files. Re-run after changing
-it: /usr/bin/python3 tests/fuzz/make_seeds.py"""
+encoding meshio can produce, plus hand-written Vega, MFEM and .bou files and numpy's .npy files.
+Re-run after changing it: /usr/bin/python3 tests/fuzz/make_seeds.py"""
 import itertools
 import os
 import shutil
@@ -81,6 +81,15 @@ def main():
     open(write("mfem", "cube.mesh"), "w").write("\n".join(lines) + "\n")
 
     open(write("bou", "fixed.bou"), "w").write("1,2,3,\n4, 8 # comment\n")
+
+    # .npy as numpy writes it: each case the reader handles, plus one dtype it refuses.
+    np.save(write("npy", "vector.npy"), np.array([0.0, -0.0, 1.5, np.nan, np.inf]))
+    np.save(write("npy", "fortran_f4.npy"), np.asfortranarray(np.arange(6, dtype="<f4").reshape(2, 3)))
+    np.save(write("npy", "big_endian.npy"), np.array([[1.0, -2.5], [1e300, 5e-324]], dtype=">f8"))
+    with open(write("npy", "version2.npy"), "wb") as f:
+        np.lib.format.write_array(f, np.arange(3.0), version=(2, 0))
+    np.save(write("npy", "empty.npy"), np.zeros((0, 3)))
+    np.save(write("npy", "int32.npy"), np.arange(4, dtype="<i4"))
 
 
 if __name__ == "__main__":
