@@ -1,10 +1,10 @@
 // quiver-bake: turns a tetrahedral mesh into a reduced model. Runs on one or many MPI ranks
-// (mpirun -n N quiver-bake ...); PETSc/SLEPc options (-eps_*, -ksp_*, -log_view) pass through.
+// (mpirun -n N quiver-bake ...); PETSc/SLEPc options (-eps_*, -st_*, -derivatives_*, -log_view)
+// pass through to the solvers.
 #include <iostream>
 
 #include "apps/support/mesh_options.h"
-#include "precompute/bake_context.h"
-#include "precompute/stages/partition.h"
+#include "precompute/bake.h"
 
 using namespace quiver;
 
@@ -12,20 +12,28 @@ int main(int argc, char** argv) {
   std::vector<std::string> own, petsc;
   splitPetscOptions(argc, argv, own, petsc);
 
-  CLI::App app{"quiver-bake: reduced St.Venant-Kirchhoff model from a tetrahedral mesh.\n"
-               "PETSc/SLEPc options (-eps_type, -ksp_type, -log_view, -options_file, ...) pass through."};
+  CLI::App app{"quiver-bake: reduced St.Venant-Kirchhoff model of a tetrahedral mesh (Barbic & James 2005).\n"
+               "Writes NAME.h5 (every stage; schema in formats/ARCHIVE.md) and NAME.xmf (ParaView).\n"
+               "PETSc/SLEPc options pass through: -eps_tol, -eps_ncv, -st_*, -derivatives_pc_*, -log_view, ..."};
   app::MeshOptions meshOptions;
   app::FixedVertexOptions fixedOptions;
-  MaterialOverride material;
-  std::string output;
+  BakeSettings s;
   bool quiet = false;
   meshOptions.addTo(app);
   fixedOptions.addTo(app);
-  app.add_option("--E", material.youngsModulus, "Young's modulus in Pa (> 0); overrides the mesh file's materials");
-  app.add_option("--nu", material.poissonRatio, "Poisson ratio in (-1, 0.5); overrides the mesh file's materials");
-  app.add_option("--density", material.density, "Density in kg/m^3 (> 0); overrides the mesh file's materials");
-  app.add_option("-o,--output", output, "Output name: writes NAME.h5 (and NAME.qvr)")->required();
-  app.add_flag("--quiet", quiet, "Print nothing but errors");
+  app.add_option("--E", s.material.youngsModulus, "Young's modulus in Pa (> 0); overrides the mesh file's materials");
+  app.add_option("--nu", s.material.poissonRatio, "Poisson ratio in (-1, 0.5); overrides the mesh file's materials");
+  app.add_option("--density", s.material.density, "Density in kg/m^3 (> 0); overrides the mesh file's materials");
+  app.add_option("--modes", s.modes, "Linear modes k (the six rigid modes of a free object are not counted)")
+      ->capture_default_str();
+  app.add_option("--rank", s.rank, "Basis vectors r, at most k + k(k+1)/2 and the free DOFs")->capture_default_str();
+  app.add_option("--basis-from", s.basisFrom,
+                 "Use this basis instead of modes + derivatives: FILE.npy or FILE.h5:/dataset, shape (3 x vertices, r) "
+                 "in the mesh file's vertex order");
+  app.add_flag("--export-npy", s.exportNpy, "Also write NAME.eigenvalues.npy, NAME.modes.npy and NAME.U.npy (float64)");
+  app.add_flag("--resume", s.resume, "Reuse the stages of NAME.h5.partial (or NAME.h5) whose inputs have not changed");
+  app.add_option("-o,--output", s.output, "Output name: writes NAME.h5 and NAME.xmf")->required();
+  app.add_flag("--quiet", quiet, "Print nothing but warnings and errors");
 
   std::vector<char*> ownArgv;
   for (auto& a : own) ownArgv.push_back(a.data());
@@ -34,35 +42,19 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
+  for (int i = 0; i < argc; ++i) s.commandLine += (i ? " " : "") + std::string(argv[i]);
+  for (size_t i = 1; i < petsc.size(); ++i) s.petscOptions += (i > 1 ? " " : "") + petsc[i];
+  s.meshPath = meshOptions.path;
+  s.checks = meshOptions.checks;
 
   BakeContext ctx(petsc);
   ctx.quiet = quiet;
   std::string error;
   try {
-    // Explicit values are checked before any work starts.
-    Material check;
-    if (material.youngsModulus) check.youngsModulus = *material.youngsModulus;
-    if (material.poissonRatio) check.poissonRatio = *material.poissonRatio;
-    if (material.density) check.density = *material.density;
-    if (std::string bad = checkMaterial(check); !bad.empty()) throw std::invalid_argument(bad);
-
-    CheckedMesh mesh = meshOptions.load(ctx.rank() == 0 ? "quiver-bake" : "");
-    std::vector<int> fixed = fixedOptions.select(mesh);
-    auto materials = resolveTetMaterials(mesh.mesh, Material{}, material);
-    for (const Material& m : materials)
-      if (std::string bad = checkMaterial(m); !bad.empty()) throw std::invalid_argument(bad);
-    ctx.progress("mesh " + meshOptions.path + ": " + std::to_string(mesh.mesh.vertexCount()) + " vertices, " +
-                 std::to_string(mesh.mesh.tetCount()) + " tets, " + std::to_string(fixed.size()) + " fixed vertices" +
-                 (fixed.empty() ? " (free object: rigid modes will be skipped)" : ""));
-
-    Partition part = partitionMesh(mesh.mesh, {ctx.size()});
-    std::vector<int> tetsPerPart(ctx.size(), 0);
-    for (int p : part.tetPart) ++tetsPerPart[p];
-    std::string sizes;
-    for (int n : tetsPerPart) sizes += (sizes.empty() ? "" : " ") + std::to_string(n);
-    ctx.progress("partition: " + std::to_string(ctx.size()) + " part(s), tets per part [" + sizes + "], " +
-                 std::to_string(part.cutFaces) + " cut faces");
-    ctx.progress("the mode, basis and polynomial stages are not built yet: stopping after the partition");
+    checkBakeSettings(s);  // before any work
+    if (!fixedOptions.indexList.empty()) fixedOptions.request.indices = parseIndexList(fixedOptions.indexList, "--fix-indices");
+    s.fixed = fixedOptions.request;
+    runBake(ctx, s);
   } catch (const std::exception& e) {
     error = e.what();
   }

@@ -33,7 +33,7 @@ Eigen::SparseMatrix<double> assembleMass(const TetMesh& mesh, const std::vector<
 } // namespace
 
 Eigen::SparseMatrix<double> consistentMassMatrix(const TetMesh& mesh, const std::vector<Material>& perTet) {
-  return assembleMass(mesh, perTet, 2.0 / 20.0, 1.0 / 20.0);
+  return assembleMass(mesh, perTet, consistentMassWeight(0, 0), consistentMassWeight(0, 1));
 }
 
 Eigen::SparseMatrix<double> lumpedMassMatrix(const TetMesh& mesh, const std::vector<Material>& perTet) {

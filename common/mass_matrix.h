@@ -12,6 +12,10 @@
 
 namespace quiver {
 
+// Weight w_ab of the consistent element mass M_e^{ab} = \rho_e V_e w_{ab} I_3: 1/10 on the
+// diagonal, 1/20 off it (\int N_a N_b dV / V for linear tets).
+constexpr double consistentMassWeight(int a, int b) { return a == b ? 0.1 : 0.05; }
+
 // Consistent mass M = \sum_e M_e with, for tet vertices a, b = 0..3,
 //   M_e^{ab} = \frac{\rho_e V_e}{20} (1 + \delta_{ab}) I_3,
 // the exact integral \int_e \rho_e N_a N_b dV of the linear shape functions. It integrates

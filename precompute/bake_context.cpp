@@ -47,6 +47,20 @@ void BakeContext::progress(const std::string& message) const {
   if (rank_ == 0 && !quiet) std::cout << "quiver-bake: " << message << std::endl;
 }
 
+void BakeContext::onRankZero(const std::function<void()>& work) const {
+  std::string error;
+  if (rank_ == 0) {
+    try {
+      work();
+    } catch (const std::exception& e) {
+      error = e.what();
+      if (error.empty()) error = "unknown error";
+    }
+  }
+  error = agreeOnError(error);
+  if (!error.empty()) throw std::runtime_error(error);
+}
+
 std::string BakeContext::agreeOnError(const std::string& localError) const {
   int mine = localError.empty() ? size_ : rank_, first = size_;
   MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm());
@@ -55,7 +69,7 @@ std::string BakeContext::agreeOnError(const std::string& localError) const {
   MPI_Bcast(&length, 1, MPI_INT, first, comm());
   std::string message = rank_ == first ? localError : std::string(length, ' ');
   MPI_Bcast(message.data(), length, MPI_CHAR, first, comm());
-  return size_ > 1 ? message + " (rank " + std::to_string(first) + ")" : message;
+  return first > 0 ? message + " (rank " + std::to_string(first) + ")" : message;
 }
 
 } // namespace quiver

@@ -1,6 +1,7 @@
 #pragma once
 // The bake's process-wide context: MPI, PETSc and SLEPc are initialised for the lifetime of one
 // BakeContext, rank 0 speaks for all ranks, and failures end every rank together.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,10 @@ public:
 
   // Rank 0 prints "quiver-bake: <message>" to stdout unless quiet.
   void progress(const std::string& message) const;
+
+  // Collective: runs `work` on rank 0 only (file writes that one process does for all), then every
+  // rank throws std::runtime_error with rank 0's message if it failed, so no rank is left waiting.
+  void onRankZero(const std::function<void()>& work) const;
 
   // Collective: every rank passes its own error ("" for none) and gets back the error of the
   // lowest failing rank, so all ranks fail together with one message and none hangs.

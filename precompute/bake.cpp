@@ -1,0 +1,261 @@
+#include "precompute/bake.h"
+
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <sstream>
+
+#include "formats/atomic_file.h"
+#include "formats/npy.h"
+#include "precompute/archive/xdmf.h"
+#include "precompute/checkpoint.h"
+#include "precompute/input_hash.h"
+#include "precompute/rigid_modes.h"
+#include "precompute/stages/assemble.h"
+#include "quiver/quiver.h"
+
+namespace quiver {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+class StageClock {
+public:
+  explicit StageClock(const BakeContext& ctx) : ctx_(ctx) {}
+  // Runs `body` as stage `name`, recording its wall time (slowest rank's view: all ranks sync).
+  template <class F>
+  void run(const std::string& name, F&& body) {
+    MPI_Barrier(ctx_.comm());
+    const auto start = std::chrono::steady_clock::now();
+    body();
+    MPI_Barrier(ctx_.comm());
+    seconds_.emplace_back(name, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  double last() const { return seconds_.back().second; }
+  const std::vector<std::pair<std::string, double>>& all() const { return seconds_; }
+
+private:
+  const BakeContext& ctx_;
+  std::vector<std::pair<std::string, double>> seconds_;
+};
+
+std::string fixed3(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+void hashMaterials(InputHash& h, const std::vector<Material>& perTet) {
+  for (const Material& m : perTet) h.add(m.youngsModulus).add(m.poissonRatio).add(m.density);
+}
+
+// The user basis as a full 3n x r matrix in the loaded mesh's vertex order.
+Eigen::MatrixXd loadUserBasis(const BakeContext& ctx, const std::string& spec, const CheckedMesh& mesh) {
+  const int64_t fileRows = 3 * static_cast<int64_t>(mesh.loadedVertex.size());
+  std::vector<int64_t> shape;
+  std::vector<double> data;
+  const size_t colon = spec.find(".h5:");
+  if (colon != std::string::npos) {
+    Archive user(ctx.comm(), spec.substr(0, colon + 3), Archive::Mode::ReadOnly);
+    data = user.readReplicatedDouble(spec.substr(colon + 4), shape);
+  } else {
+    NpyArray a = readNpy(spec);
+    shape = a.shape;
+    data = std::move(a.data);
+  }
+  if (shape.size() != 2 || shape[0] != fileRows)
+    throw std::runtime_error(spec + ": a basis must have shape (3 x " + std::to_string(mesh.loadedVertex.size()) +
+                             " vertices, r) = (" + std::to_string(fileRows) + ", r)");
+  const int64_t r = shape[1];
+  Eigen::MatrixXd full(3 * static_cast<int64_t>(mesh.fileVertex.size()), r);
+  for (size_t v = 0; v < mesh.fileVertex.size(); ++v)
+    for (int c = 0; c < 3; ++c)
+      for (int64_t j = 0; j < r; ++j) full(3 * v + c, j) = data[(3 * mesh.fileVertex[v] + c) * r + j];
+  return full;
+}
+
+// 3N x cols in the input file's vertex order (zeros for vertices the loader dropped), row-major.
+std::vector<double> inFileOrder(const Eigen::MatrixXd& full, const CheckedMesh& mesh) {
+  const int64_t cols = full.cols();
+  std::vector<double> out(3 * mesh.loadedVertex.size() * cols, 0.0);
+  for (size_t v = 0; v < mesh.fileVertex.size(); ++v)
+    for (int c = 0; c < 3; ++c)
+      for (int64_t j = 0; j < cols; ++j) out[(3 * mesh.fileVertex[v] + c) * cols + j] = full(3 * v + c, j);
+  return out;
+}
+
+std::string isoNow() {
+  std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
+} // namespace
+
+void checkBakeSettings(const BakeSettings& s) {
+  Material check = s.fallback;
+  if (s.material.youngsModulus) check.youngsModulus = *s.material.youngsModulus;
+  if (s.material.poissonRatio) check.poissonRatio = *s.material.poissonRatio;
+  if (s.material.density) check.density = *s.material.density;
+  if (std::string bad = checkMaterial(check); !bad.empty()) throw std::invalid_argument(bad);
+  if (s.modes < 1) throw std::invalid_argument("--modes must be at least 1");
+  if (s.rank < 1) throw std::invalid_argument("--rank must be at least 1");
+  if (s.basisFrom.empty() && s.rank > s.modes + s.modes * (s.modes + 1) / 2)
+    throw std::invalid_argument("--rank " + std::to_string(s.rank) + " exceeds the " +
+                                std::to_string(s.modes + s.modes * (s.modes + 1) / 2) + " vectors that " +
+                                std::to_string(s.modes) + " modes and their derivatives give; raise --modes");
+  if (s.output.empty()) throw std::invalid_argument("-o NAME is required");
+  const fs::path folder = fs::path(s.output).parent_path();
+  if (!folder.empty() && !fs::is_directory(folder))
+    throw std::invalid_argument("output folder '" + folder.string() + "' does not exist");
+}
+
+void runBake(const BakeContext& ctx, const BakeSettings& s) {
+  checkBakeSettings(s);
+  StageClock clock(ctx);
+
+  // Stage: mesh. Every rank reads and checks the same file, so every rank fails alike.
+  CheckedMesh mesh;
+  std::vector<int> fixed;
+  std::vector<Material> perTet;
+  std::string meshHash;
+  clock.run("mesh", [&] {
+    mesh = loadMesh(s.meshPath, s.checks);
+    fixed = selectFixedVertices(mesh, s.fixed);
+    perTet = resolveTetMaterials(mesh.mesh, s.fallback, s.material);
+    for (const Material& m : perTet)
+      if (std::string bad = checkMaterial(m); !bad.empty()) throw std::invalid_argument(s.meshPath + ": " + bad);
+    InputHash h;
+    h.add(readFileBytes(s.meshPath)).add(s.checks.fixOrientation).add(s.checks.degenerateTolerance).add(fixed);
+    hashMaterials(h, perTet);
+    meshHash = h.hex();
+  });
+  if (ctx.rank() == 0)
+    for (const std::string& w : mesh.warnings) std::fprintf(stderr, "quiver-bake: warning: %s\n", w.c_str());
+  const int64_t freeDofs = 3 * (static_cast<int64_t>(mesh.mesh.vertexCount()) - static_cast<int64_t>(fixed.size()));
+  const bool freeObject = fixed.empty();
+  if (s.modes + (freeObject ? 6 : 0) > freeDofs || s.rank > freeDofs)
+    throw std::invalid_argument("the mesh has " + std::to_string(freeDofs) + " free DOFs: too few for --modes " +
+                                std::to_string(s.modes) + " and --rank " + std::to_string(s.rank));
+  ctx.progress("mesh: " + std::to_string(mesh.mesh.vertexCount()) + " vertices, " +
+               std::to_string(mesh.mesh.tetCount()) + " tets, " + std::to_string(fixed.size()) + " fixed vertices" +
+               (freeObject ? " (free object: the six rigid modes are skipped)" : "") + ", " +
+               std::to_string(freeDofs) + " free DOFs [" + fixed3(clock.last()) + " s]");
+
+  Partition partition;
+  clock.run("partition", [&] { partition = partitionMesh(mesh.mesh, {ctx.size()}); });
+  ctx.progress("partition: " + std::to_string(ctx.size()) + " part(s), " + std::to_string(partition.cutFaces) +
+               " cut faces [" + fixed3(clock.last()) + " s]");
+
+  // The archive: NAME.h5.partial until the bake completes; --resume starts from it (or NAME.h5).
+  const std::string finalPath = s.output + ".h5", partialPath = finalPath + ".partial";
+  bool reuse = false;
+  if (s.resume) {
+    if (fs::exists(partialPath)) {
+      reuse = true;
+    } else if (fs::exists(finalPath)) {
+      ctx.onRankZero([&] { fs::copy_file(finalPath, partialPath, fs::copy_options::overwrite_existing); });
+      reuse = true;
+    }
+  }
+  Archive archive(ctx.comm(), partialPath, reuse ? Archive::Mode::ReadWrite : Archive::Mode::Create);
+  archive.setAttribute("/", "format", std::string("quiver bake archive"));
+  archive.setAttribute("/", "schema_version", static_cast<int64_t>(1));
+  archive.setAttribute("/", "quiver_version", std::string(qv_version_string()));
+  writeInputs(archive, mesh, s.meshPath, perTet, fixed, partition, ctx.size());
+
+  DofLayout layout(ctx.comm(), partition.vertexPart, fixed);
+  AssembledSystem system;
+  clock.run("assemble", [&] { system = assembleSystem(mesh.mesh, perTet, partition.tetPart, layout); });
+  ctx.progress("assemble: K and M of " + std::to_string(layout.globalDofs()) + " DOFs [" + fixed3(clock.last()) + " s]");
+  const Eigen::MatrixXd rigid = freeObject ? rigidModes(mesh.mesh, system.mass, layout) : Eigen::MatrixXd();
+
+  const std::string modesHash = InputHash().add(meshHash).add(s.modes).add(s.petscOptions).hex();
+  LinearModes modes;
+  bool reused = false;
+  clock.run("modes", [&] {
+    reused = reuse && storedInputHash(archive, "/modes") == modesHash;
+    if (reused) {
+      modes = readModes(archive, layout);
+      return;
+    }
+    ModeSettings settings;
+    settings.count = s.modes;
+    modes = computeLinearModes(system.stiffness, system.mass, layout, settings, rigid);
+    writeModes(archive, modes, layout, modesHash);
+  });
+  const auto hz = modes.frequenciesHz();
+  ctx.progress(std::string("modes: ") + (reused ? "reused, " : "") + std::to_string(s.modes) + " modes, " + fixed3(hz.front()) + " to " + fixed3(hz.back()) +
+               " Hz, max residual " + fixed3(*std::max_element(modes.residuals.begin(), modes.residuals.end())) +
+               " [" + fixed3(clock.last()) + " s]");
+
+  ReducedBasis basis;
+  std::string basisSource = "modes+derivatives";
+  if (s.basisFrom.empty()) {
+    const std::string derivativesHash = InputHash().add(modesHash).add(std::string("derivatives 1")).hex();
+    ModalDerivatives derivatives;
+    clock.run("derivatives", [&] {
+      reused = reuse && storedInputHash(archive, "/derivatives") == derivativesHash;
+      if (reused) {
+        derivatives = readDerivatives(archive, layout);
+        return;
+      }
+      derivatives = computeModalDerivatives(mesh.mesh, perTet, partition.tetPart, system.stiffness, system.mass,
+                                            layout, modes, rigid, DerivativeSettings{});
+      writeDerivatives(archive, derivatives, layout, derivativesHash);
+    });
+    ctx.progress(std::string("derivatives: ") + (reused ? "reused, " : "") + std::to_string(derivatives.pairs.size()) +
+                 " solved, max residual " +
+                 fixed3(*std::max_element(derivatives.residuals.begin(), derivatives.residuals.end())) + " [" +
+                 fixed3(clock.last()) + " s]");
+    clock.run("basis", [&] {
+      BasisSettings settings;
+      settings.rank = s.rank;
+      basis = buildBasis(system.mass, layout, modes, derivatives, settings);
+      writeBasis(archive, basis, basisSource, layout, InputHash().add(derivativesHash).add(s.rank).hex());
+    });
+  } else {
+    basisSource = s.basisFrom;
+    clock.run("basis", [&] {
+      bool wasOrthonormal = true;
+      const Eigen::MatrixXd full = loadUserBasis(ctx, s.basisFrom, mesh);
+      basis = importBasis(system.mass, layout, layout.localRowsOf(full), wasOrthonormal);
+      if (!wasOrthonormal) ctx.progress("warning: " + s.basisFrom + " was not M-orthonormal; it was orthonormalised");
+      writeBasis(archive, basis, basisSource, layout, InputHash().add(meshHash).add(s.basisFrom).hex());
+    });
+  }
+  ctx.progress("basis: r = " + std::to_string(basis.vectors.cols()) + ", max |U^T M U - I| = " +
+               fixed3(basis.orthonormalityError) + " [" + fixed3(clock.last()) + " s]");
+
+  if (s.exportNpy) {
+    const Eigen::MatrixXd fullModes = layout.gatherToAll(modes.vectors), fullU = layout.gatherToAll(basis.vectors);
+    ctx.onRankZero([&] {
+      const int64_t rows = 3 * static_cast<int64_t>(mesh.loadedVertex.size());
+      writeNpy(s.output + ".eigenvalues.npy", {static_cast<int64_t>(modes.eigenvalues.size())}, modes.eigenvalues.data());
+      writeNpy(s.output + ".modes.npy", {rows, fullModes.cols()}, inFileOrder(fullModes, mesh).data());
+      writeNpy(s.output + ".U.npy", {rows, fullU.cols()}, inFileOrder(fullU, mesh).data());
+    });
+  }
+
+  archive.createGroup("/provenance");
+  archive.setAttribute("/provenance", "quiver_version", std::string(qv_version_string()));
+  archive.setAttribute("/provenance", "command_line", s.commandLine);
+  archive.setAttribute("/provenance", "ranks", static_cast<int64_t>(ctx.size()));
+  archive.setAttribute("/provenance", "created", isoNow());
+  archive.setAttribute("/provenance", "mesh_hash", meshHash);
+  for (const auto& [stage, seconds] : clock.all()) archive.setAttribute("/provenance", stage + "_seconds", seconds);
+  archive.flush();
+  const std::string h5Name = fs::path(finalPath).filename().string();
+  std::vector<std::pair<std::string, int64_t>> fields = {{"/modes/vectors", modes.vectors.cols()},
+                                                         {"/basis/vectors", basis.vectors.cols()}};
+  if (s.basisFrom.empty()) fields.insert(fields.begin() + 1, {"/derivatives/vectors", s.modes * (s.modes + 1) / 2});
+  ctx.onRankZero([&] { writeModesXdmf(s.output + ".xmf", h5Name, mesh.mesh.vertexCount(), mesh.mesh.tetCount(), fields); });
+  archive.close();
+  ctx.onRankZero([&] { fs::rename(partialPath, finalPath); });
+  ctx.progress("wrote " + finalPath + " and " + s.output + ".xmf");
+}
+
+} // namespace quiver

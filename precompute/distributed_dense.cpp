@@ -1,0 +1,39 @@
+#include "precompute/distributed_dense.h"
+
+namespace quiver {
+
+PetscMat wrapDense(Eigen::MatrixXd& local, const DofLayout& layout) {
+  PetscMat D;
+  QV_PETSC(MatCreateDense(layout.comm(), layout.localDofs(), PETSC_DECIDE, layout.globalDofs(),
+                          static_cast<PetscInt>(local.cols()), local.data(), D.out()));
+  return D;
+}
+
+Eigen::MatrixXd multiply(Mat A, const Eigen::MatrixXd& X, const DofLayout& layout) {
+  Eigen::MatrixXd input = X;  // PETSc wants a writable array even for a read-only operand
+  PetscMat D = wrapDense(input, layout);
+  PetscMat product;
+  QV_PETSC(MatMatMult(A, D, MAT_INITIAL_MATRIX, PETSC_DEFAULT, product.out()));
+  const PetscScalar* values = nullptr;
+  PetscInt lda = 0;
+  QV_PETSC(MatDenseGetLDA(product, &lda));
+  QV_PETSC(MatDenseGetArrayRead(product, &values));
+  Eigen::MatrixXd out = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>(
+      values, layout.localDofs(), X.cols(), Eigen::OuterStride<>(lda));
+  QV_PETSC(MatDenseRestoreArrayRead(product, &values));
+  return out;
+}
+
+Eigen::MatrixXd innerProducts(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, MPI_Comm comm) {
+  Eigen::MatrixXd mine = X.transpose() * Y, total(mine.rows(), mine.cols());
+  MPI_Allreduce(mine.data(), total.data(), static_cast<int>(mine.size()), MPI_DOUBLE, MPI_SUM, comm);
+  return total;
+}
+
+Eigen::VectorXd columnNorms(const Eigen::MatrixXd& X, MPI_Comm comm) {
+  Eigen::VectorXd mine = X.colwise().squaredNorm().transpose(), total(mine.size());
+  MPI_Allreduce(mine.data(), total.data(), static_cast<int>(mine.size()), MPI_DOUBLE, MPI_SUM, comm);
+  return total.cwiseSqrt();
+}
+
+} // namespace quiver

@@ -1,0 +1,24 @@
+#pragma once
+// Row-distributed dense blocks (this rank's rows of a tall global matrix, as an Eigen matrix in
+// the DofLayout's row order) and the few operations the bake needs on them.
+#include <Eigen/Core>
+#include <petscmat.h>
+
+#include "precompute/dof_layout.h"
+#include "precompute/stages/assemble.h"
+
+namespace quiver {
+
+// A PETSc MPIDENSE matrix that shares `local`'s storage (no copy); `local` must outlive it.
+PetscMat wrapDense(Eigen::MatrixXd& local, const DofLayout& layout);
+
+// This rank's rows of A X, for a distributed sparse A and row-distributed X. Collective.
+Eigen::MatrixXd multiply(Mat A, const Eigen::MatrixXd& X, const DofLayout& layout);
+
+// X^T Y summed over all ranks: the same small matrix on every rank. Collective.
+Eigen::MatrixXd innerProducts(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, MPI_Comm comm);
+
+// Euclidean norm of each global column. Collective.
+Eigen::VectorXd columnNorms(const Eigen::MatrixXd& X, MPI_Comm comm);
+
+} // namespace quiver

@@ -1,0 +1,148 @@
+#include "precompute/stages/modal_derivatives.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Geometry>
+#include <petscksp.h>
+
+#include "common/stvk_element.h"
+#include "precompute/distributed_dense.h"
+
+namespace quiver {
+
+namespace {
+
+using PetscKsp = PetscHandle<KSP, KSPDestroy>;
+
+// -d^2R[phi_i, phi_j] for every pair, as a distributed dense matrix (free DOFs x pairs).
+PetscMat rightHandSides(const TetMesh& mesh, const std::vector<Material>& perTet, const std::vector<int>& tetPart,
+                        const DofLayout& layout, const Eigen::MatrixXd& fullModes,
+                        const std::vector<std::array<int, 2>>& pairs) {
+  int rank = 0;
+  MPI_Comm_rank(layout.comm(), &rank);
+  const PetscInt P = static_cast<PetscInt>(pairs.size());
+  PetscMat B;
+  QV_PETSC(MatCreateDense(layout.comm(), layout.localDofs(), PETSC_DECIDE, layout.globalDofs(), P, nullptr, B.out()));
+  QV_PETSC(MatZeroEntries(B));
+  const TetElements elements = computeTetElements(mesh);
+  std::vector<PetscInt> columns(P);
+  for (PetscInt p = 0; p < P; ++p) columns[p] = p;
+  std::vector<Matrix34> modeOnTet(fullModes.cols());
+  Eigen::Matrix<double, 12, Eigen::Dynamic, Eigen::RowMajor> values(12, P);
+  PetscInt dofs[12];
+  for (int t = 0; t < mesh.tetCount(); ++t) {
+    if (tetPart[t] != rank) continue;
+    const Tet& tet = mesh.tets[t];
+    for (int i = 0; i < fullModes.cols(); ++i)
+      for (int a = 0; a < 4; ++a) modeOnTet[i].col(a) = fullModes.block<3, 1>(3 * tet[a], i);
+    const Material& m = perTet[t];
+    for (PetscInt p = 0; p < P; ++p) {
+      const Matrix34 f = stvkElementForceHessianAtRest(modeOnTet[pairs[p][0]], modeOnTet[pairs[p][1]],
+                                                       elements.gradients[t], elements.volume[t], m.lambda(), m.mu());
+      values.col(p) = -Eigen::Map<const Eigen::Matrix<double, 12, 1>>(f.data());
+    }
+    for (int a = 0; a < 4; ++a)
+      for (int c = 0; c < 3; ++c) dofs[3 * a + c] = static_cast<PetscInt>(layout.dof(tet[a], c));
+    QV_PETSC(MatSetValues(B, 12, dofs, P, columns.data(), values.data(), ADD_VALUES));
+  }
+  QV_PETSC(MatAssemblyBegin(B, MAT_FINAL_ASSEMBLY));
+  QV_PETSC(MatAssemblyEnd(B, MAT_FINAL_ASSEMBLY));
+  return B;
+}
+
+Eigen::MatrixXd localBlock(Mat dense, const DofLayout& layout) {
+  PetscInt lda = 0, cols = 0;
+  const PetscScalar* values = nullptr;
+  QV_PETSC(MatGetSize(dense, nullptr, &cols));
+  QV_PETSC(MatDenseGetLDA(dense, &lda));
+  QV_PETSC(MatDenseGetArrayRead(dense, &values));
+  Eigen::MatrixXd out = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>(values, layout.localDofs(), cols,
+                                                                                  Eigen::OuterStride<>(lda));
+  QV_PETSC(MatDenseRestoreArrayRead(dense, &values));
+  return out;
+}
+
+// Six DOFs whose pinning removes exactly the rigid motions: all of a vertex a, the two components
+// of a far vertex b most perpendicular to b - a, and the component of a third vertex c along the
+// normal of the plane (a, b, c). Every rank picks the same ones from the same mesh.
+std::vector<PetscInt> pinnedDofs(const TetMesh& mesh, const DofLayout& layout) {
+  const auto& X = mesh.vertices;
+  const int a = 0;
+  int b = 0, c = 0;
+  for (int v = 0; v < mesh.vertexCount(); ++v)
+    if ((X[v] - X[a]).squaredNorm() > (X[b] - X[a]).squaredNorm()) b = v;
+  const Eigen::Vector3d d = (X[b] - X[a]).normalized();
+  auto offAxis = [&](int v) { return ((X[v] - X[a]) - (X[v] - X[a]).dot(d) * d).squaredNorm(); };
+  for (int v = 0; v < mesh.vertexCount(); ++v)
+    if (offAxis(v) > offAxis(c)) c = v;
+  const Eigen::Vector3d normal = d.cross(X[c] - X[a]);
+  int along = 0, least = 0;
+  normal.cwiseAbs().maxCoeff(&along);
+  d.cwiseAbs().maxCoeff(&least);  // b's component along d cannot block rotations: skip it
+  std::vector<PetscInt> dofs = {static_cast<PetscInt>(layout.dof(a, 0)), static_cast<PetscInt>(layout.dof(a, 1)),
+                                static_cast<PetscInt>(layout.dof(a, 2)), static_cast<PetscInt>(layout.dof(c, along))};
+  for (int k = 0; k < 3; ++k)
+    if (k != least) dofs.push_back(static_cast<PetscInt>(layout.dof(b, k)));
+  return dofs;
+}
+
+} // namespace
+
+ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<Material>& perTet,
+                                         const std::vector<int>& tetPart, Mat stiffness, Mat mass,
+                                         const DofLayout& layout, const LinearModes& modes,
+                                         const Eigen::MatrixXd& rigid, const DerivativeSettings& settings) {
+  ModalDerivatives out;
+  const int k = static_cast<int>(modes.eigenvalues.size());
+  for (int i = 0; i < k; ++i)
+    for (int j = i; j < k; ++j) out.pairs.push_back({i, j});
+
+  PetscMat B = rightHandSides(mesh, perTet, tetPart, layout, layout.gatherToAll(modes.vectors), out.pairs);
+  Eigen::MatrixXd b = localBlock(B, layout);  // right-hand sides; projected below on free objects
+  Eigen::MatrixXd solveFor;                    // what the (possibly pinned) system is solved for
+  const bool freeObject = rigid.cols() > 0;
+  PetscMat pinned;
+  Mat op = stiffness;
+  if (freeObject) {
+    // Project b off the rigid modes (R^T b = 0 makes K x = b solvable), then pin six DOFs.
+    b -= multiply(mass, rigid, layout) * innerProducts(rigid, b, layout.comm());
+    const std::vector<PetscInt> pins = pinnedDofs(mesh, layout);
+    solveFor = b;
+    for (PetscInt row : pins)
+      if (row >= layout.rowStart() && row < layout.rowStart() + layout.localDofs())
+        solveFor.row(row - layout.rowStart()).setZero();
+    QV_PETSC(MatDuplicate(stiffness, MAT_COPY_VALUES, pinned.out()));
+    QV_PETSC(MatZeroRowsColumns(pinned, static_cast<PetscInt>(pins.size()), pins.data(), 1.0, nullptr, nullptr));
+    op = pinned;
+  } else {
+    solveFor = b;
+  }
+
+  PetscKsp ksp;
+  PC pc;
+  QV_PETSC(KSPCreate(layout.comm(), ksp.out()));
+  QV_PETSC(KSPSetOptionsPrefix(ksp, "derivatives_"));
+  QV_PETSC(KSPSetOperators(ksp, op, op));
+  QV_PETSC(KSPSetType(ksp, KSPPREONLY));
+  QV_PETSC(KSPGetPC(ksp, &pc));
+  QV_PETSC(PCSetType(pc, PCCHOLESKY));
+  QV_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  QV_PETSC(KSPSetFromOptions(ksp));
+  out.vectors.resize(layout.localDofs(), static_cast<Eigen::Index>(out.pairs.size()));
+  PetscMat rhs = wrapDense(solveFor, layout), solution = wrapDense(out.vectors, layout);
+  QV_PETSC(KSPMatSolve(ksp, rhs, solution));
+  if (freeObject) out.vectors -= rigid * innerProducts(rigid, multiply(mass, out.vectors, layout), layout.comm());
+
+  // Residual against the unpinned system and the projected right-hand side.
+  const Eigen::VectorXd rn = columnNorms(multiply(stiffness, out.vectors, layout) - b, layout.comm());
+  const Eigen::VectorXd bn = columnNorms(b, layout.comm());
+  for (size_t p = 0; p < out.pairs.size(); ++p) {
+    out.residuals.push_back(bn[p] > 0 ? rn[p] / bn[p] : rn[p]);
+    if (!(out.residuals.back() <= settings.maxResidual))
+      throw std::runtime_error("modal derivative (" + std::to_string(out.pairs[p][0]) + ", " +
+                               std::to_string(out.pairs[p][1]) + ") has relative residual " +
+                               std::to_string(out.residuals.back()) + ", above the limit");
+  }
+  return out;
+}
+
+} // namespace quiver

@@ -1,0 +1,37 @@
+#pragma once
+// Stage "derivatives": modal derivatives K Psi_ij = -d^2R[phi_i, phi_j] for i <= j <= k (Barbič &
+// James 2005), the second derivative of the internal force at rest applied to two modes. Each rank
+// computes the right-hand sides of its tets exactly (stvkElementForceHessianAtRest); all k(k+1)/2
+// are solved as one block with one factorization of K (MUMPS Cholesky; -derivatives_* options).
+// On a free object K is singular: the right-hand sides are projected off the rigid modes, six
+// DOFs are pinned to pick one solution, and the result is made M-orthogonal to the rigid modes.
+#include <array>
+#include <vector>
+
+#include <Eigen/Core>
+#include <petscmat.h>
+
+#include "common/tet_mesh.h"
+#include "precompute/dof_layout.h"
+#include "precompute/stages/modes.h"
+
+namespace quiver {
+
+struct DerivativeSettings {
+  double maxResidual = 1e-8;  // refuse solutions with ||K Psi - b|| / ||b|| above this
+};
+
+struct ModalDerivatives {
+  std::vector<std::array<int, 2>> pairs;  // (i, j), i <= j, in order (0,0), (0,1), ..., (k-1,k-1)
+  Eigen::MatrixXd vectors;                // this rank's rows, one column per pair
+  std::vector<double> residuals;          // ||K Psi - b|| / ||b|| per pair
+};
+
+// Collective. `tetPart` says which tets this rank integrates; `rigid` is rigidModes() on a free
+// object and empty (0 columns) otherwise.
+ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<Material>& perTet,
+                                         const std::vector<int>& tetPart, Mat stiffness, Mat mass,
+                                         const DofLayout& layout, const LinearModes& modes,
+                                         const Eigen::MatrixXd& rigid, const DerivativeSettings& settings);
+
+} // namespace quiver

@@ -1,0 +1,164 @@
+#include "precompute/stages/modes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include <slepceps.h>
+
+#include "precompute/distributed_dense.h"
+
+namespace quiver {
+
+namespace {
+
+using PetscEps = PetscHandle<EPS, EPSDestroy>;
+using PetscVec = PetscHandle<Vec, VecDestroy>;
+
+struct EigenPairs {
+  std::vector<double> values;  // ascending
+  Eigen::MatrixXd vectors;     // this rank's rows
+};
+
+// The `count` eigenpairs nearest `shift` by Krylov-Schur with shift-and-invert (MUMPS Cholesky),
+// M-orthogonal to `deflation`'s columns. `fromOptions` lets -eps_* / -st_* override the defaults.
+EigenPairs solveNearShift(Mat stiffness, Mat mass, const DofLayout& layout, double shift, int count, double tolerance,
+                          const Eigen::MatrixXd& deflation, bool fromOptions) {
+  PetscEps eps;
+  QV_PETSC(EPSCreate(layout.comm(), eps.out()));
+  QV_PETSC(EPSSetOperators(eps, stiffness, mass));
+  QV_PETSC(EPSSetProblemType(eps, EPS_GHEP));
+  QV_PETSC(EPSSetType(eps, EPSKRYLOVSCHUR));
+  QV_PETSC(EPSSetWhichEigenpairs(eps, EPS_TARGET_MAGNITUDE));
+  QV_PETSC(EPSSetTarget(eps, shift));
+  QV_PETSC(EPSSetDimensions(eps, count, PETSC_DEFAULT, PETSC_DEFAULT));
+  QV_PETSC(EPSSetTolerances(eps, tolerance, 1000));
+  ST st;
+  KSP ksp;
+  PC pc;
+  QV_PETSC(EPSGetST(eps, &st));
+  QV_PETSC(STSetType(st, STSINVERT));
+  QV_PETSC(STGetKSP(st, &ksp));
+  QV_PETSC(KSPSetType(ksp, KSPPREONLY));
+  QV_PETSC(KSPGetPC(ksp, &pc));
+  QV_PETSC(PCSetType(pc, PCCHOLESKY));
+  QV_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  std::vector<PetscVec> deflationVecs(deflation.cols());
+  std::vector<Vec> raw;
+  for (Eigen::Index j = 0; j < deflation.cols(); ++j) {
+    QV_PETSC(MatCreateVecs(stiffness, deflationVecs[j].out(), nullptr));
+    PetscScalar* values;
+    QV_PETSC(VecGetArray(deflationVecs[j], &values));
+    Eigen::Map<Eigen::VectorXd>(values, layout.localDofs()) = deflation.col(j);
+    QV_PETSC(VecRestoreArray(deflationVecs[j], &values));
+    raw.push_back(deflationVecs[j]);
+  }
+  if (!raw.empty()) QV_PETSC(EPSSetDeflationSpace(eps, static_cast<PetscInt>(raw.size()), raw.data()));
+  if (fromOptions) QV_PETSC(EPSSetFromOptions(eps));
+  QV_PETSC(EPSSolve(eps));
+
+  PetscInt converged = 0;
+  QV_PETSC(EPSGetConverged(eps, &converged));
+  if (converged < count) {
+    EPSConvergedReason reason;
+    QV_PETSC(EPSGetConvergedReason(eps, &reason));
+    std::ostringstream why;
+    why << "SLEPc found " << converged << " of the " << count << " eigenpairs requested (" << EPSConvergedReasons[reason]
+        << "); try a larger -eps_max_it or -eps_ncv";
+    throw std::runtime_error(why.str());
+  }
+  std::vector<double> lambda(converged);
+  for (PetscInt i = 0; i < converged; ++i) {
+    PetscScalar re, im;
+    QV_PETSC(EPSGetEigenvalue(eps, i, &re, &im));
+    lambda[i] = re;
+  }
+  std::vector<int> order(converged);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return lambda[a] < lambda[b]; });
+  EigenPairs out;
+  out.vectors.resize(layout.localDofs(), count);
+  PetscVec x;
+  QV_PETSC(MatCreateVecs(stiffness, x.out(), nullptr));
+  for (int j = 0; j < count; ++j) {
+    out.values.push_back(lambda[order[j]]);
+    QV_PETSC(EPSGetEigenvector(eps, order[j], x, nullptr));
+    const PetscScalar* values;
+    QV_PETSC(VecGetArrayRead(x, &values));
+    out.vectors.col(j) = Eigen::Map<const Eigen::VectorXd>(values, layout.localDofs());
+    QV_PETSC(VecRestoreArrayRead(x, &values));
+  }
+  return out;
+}
+
+// Largest diagonal ratio K_ii / M_ii: the scale of the pencil's eigenvalues.
+double diagonalRatio(Mat stiffness, Mat mass) {
+  PetscVec k, m;
+  QV_PETSC(MatCreateVecs(stiffness, k.out(), nullptr));
+  QV_PETSC(MatCreateVecs(mass, m.out(), nullptr));
+  QV_PETSC(MatGetDiagonal(stiffness, k));
+  QV_PETSC(MatGetDiagonal(mass, m));
+  QV_PETSC(VecPointwiseDivide(k, k, m));
+  PetscReal ratio = 0;
+  QV_PETSC(VecMax(k, nullptr, &ratio));
+  return ratio;
+}
+
+} // namespace
+
+std::vector<double> LinearModes::frequenciesHz() const {
+  std::vector<double> f;
+  for (double lambda : eigenvalues) f.push_back(std::sqrt(std::max(lambda, 0.0)) / (2 * M_PI));
+  return f;
+}
+
+std::vector<double> eigenResiduals(Mat stiffness, Mat mass, const std::vector<double>& eigenvalues,
+                                   const Eigen::MatrixXd& vectors, const DofLayout& layout) {
+  PetscReal normK = 0;
+  QV_PETSC(MatNorm(stiffness, NORM_1, &normK));
+  Eigen::MatrixXd r = multiply(stiffness, vectors, layout) -
+                      multiply(mass, vectors, layout) * Eigen::Map<const Eigen::VectorXd>(eigenvalues.data(), eigenvalues.size()).asDiagonal();
+  const Eigen::VectorXd rn = columnNorms(r, layout.comm()), xn = columnNorms(vectors, layout.comm());
+  std::vector<double> out;
+  for (int j = 0; j < rn.size(); ++j) out.push_back(rn[j] / (normK * xn[j]));
+  return out;
+}
+
+LinearModes computeLinearModes(Mat stiffness, Mat mass, const DofLayout& layout, const ModeSettings& settings,
+                               const Eigen::MatrixXd& rigid) {
+  const int64_t available = layout.globalDofs() - rigid.cols();
+  if (settings.count > available)
+    throw std::runtime_error("cannot compute " + std::to_string(settings.count) + " modes of a system with " +
+                             std::to_string(available) + " elastic degrees of freedom");
+  LinearModes out;
+  out.rigidSkipped = static_cast<int>(rigid.cols());
+  if (out.rigidSkipped > 0) {
+    // K - sigma M is nearly singular for sigma just below 0: good enough to locate the first elastic
+    // eigenvalue, not to compute modes accurately. Then solve again at half that value.
+    const double first = solveNearShift(stiffness, mass, layout, -1e-8 * diagonalRatio(stiffness, mass), 1, 1e-6,
+                                        rigid, false).values[0];
+    out.shift = -0.5 * first;
+  }
+  EigenPairs pairs = solveNearShift(stiffness, mass, layout, out.shift, settings.count, settings.tolerance, rigid, true);
+  out.eigenvalues = std::move(pairs.values);
+  out.vectors = std::move(pairs.vectors);
+  // SLEPc returns M-normalised vectors for GHEP; normalise again so the contract does not rest on it.
+  const Eigen::MatrixXd Mphi = multiply(mass, out.vectors, layout);
+  for (int j = 0; j < settings.count; ++j) {
+    const double norm = std::sqrt(innerProducts(out.vectors.col(j), Mphi.col(j), layout.comm())(0, 0));
+    out.vectors.col(j) /= norm;
+  }
+  layout.orientColumns(out.vectors);
+  out.residuals = eigenResiduals(stiffness, mass, out.eigenvalues, out.vectors, layout);
+  for (int j = 0; j < settings.count; ++j)
+    if (!(out.residuals[j] <= settings.maxResidual)) {
+      std::ostringstream why;
+      why << "mode " << j << " (lambda = " << out.eigenvalues[j] << ") has relative residual " << out.residuals[j]
+          << ", above " << settings.maxResidual << "; tighten -eps_tol";
+      throw std::runtime_error(why.str());
+    }
+  return out;
+}
+
+} // namespace quiver

@@ -1,0 +1,45 @@
+#pragma once
+// Stage "modes": the lowest vibration modes K phi = lambda M phi of the free DOFs, by SLEPc's
+// Krylov-Schur with shift-and-invert and a parallel direct factorization (MUMPS). On a free
+// object (no fixed vertex) K is singular: the six rigid motions are deflated (the solver works
+// M-orthogonally to them), and the shift is placed below zero at half the first elastic
+// eigenvalue, which a cheap first solve estimates; so K - sigma M is definite and as well
+// conditioned as on a clamped object.
+// The defaults can be overridden from the command line with SLEPc's own options (-eps_*, -st_*).
+#include <vector>
+
+#include <Eigen/Core>
+#include <petscmat.h>
+
+#include "precompute/dof_layout.h"
+
+namespace quiver {
+
+struct ModeSettings {
+  int count = 20;            // k, elastic modes wanted (>= 1)
+  double tolerance = 1e-12;  // SLEPc's convergence tolerance (-eps_tol overrides)
+  double maxResidual = 1e-8; // refuse pairs with ||K phi - lambda M phi|| / (||K||_1 ||phi||) above this
+};
+
+struct LinearModes {
+  std::vector<double> eigenvalues;  // ascending, (rad/s)^2
+  std::vector<double> residuals;    // ||K phi - lambda M phi|| / (||K||_1 ||phi||), each below maxResidual
+  Eigen::MatrixXd vectors;          // this rank's rows (layout.localDofs() x k), M-orthonormal, oriented
+  int rigidSkipped = 0;             // 6 on a free object (deflated rigid motions)
+  double shift = 0;                 // sigma used for shift-and-invert
+
+  // f = sqrt(lambda) / (2 pi), in Hz.
+  std::vector<double> frequenciesHz() const;
+};
+
+// `rigid`: on a free object, rigidModes() (this rank's rows); empty (0 columns) when vertices are
+// fixed. Collective. Throws std::runtime_error when SLEPc fails or does not converge, or when the
+// residual check fails.
+LinearModes computeLinearModes(Mat stiffness, Mat mass, const DofLayout& layout, const ModeSettings& settings,
+                               const Eigen::MatrixXd& rigid);
+
+// ||K phi_i - lambda_i M phi_i|| / (||K||_1 ||phi_i||) for the columns of `vectors` (local rows).
+std::vector<double> eigenResiduals(Mat stiffness, Mat mass, const std::vector<double>& eigenvalues,
+                                   const Eigen::MatrixXd& vectors, const DofLayout& layout);
+
+} // namespace quiver

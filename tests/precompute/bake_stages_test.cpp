@@ -1,0 +1,197 @@
+// The bake's stages on 1 or 2 MPI ranks against dense references computed here with Eigen from
+// the common/ FEM: a generalized eigen-solve, dense solves of the derivative systems, and a dense
+// mass-PCA. Every rank count must match the same references, so ranks agree with each other.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include "common/box_mesh.h"
+#include "common/mass_matrix.h"
+#include "common/stvk_force_model.h"
+#include "precompute/distributed_dense.h"
+#include "precompute/rigid_modes.h"
+#include "precompute/stages/assemble.h"
+#include "precompute/stages/basis.h"
+#include "precompute/stages/modal_derivatives.h"
+#include "precompute/stages/modes.h"
+#include "precompute/stages/partition.h"
+
+using namespace quiver;
+
+namespace {
+
+struct Problem {
+  TetMesh mesh;
+  std::vector<Material> perTet;
+  std::vector<int> fixed;
+  Partition partition;
+  std::unique_ptr<DofLayout> layout;
+  AssembledSystem system;
+  Eigen::MatrixXd rigid;  // the bake's rigid modes on a free object, else empty
+  // Dense references over the free DOFs in vertex order.
+  std::vector<int> freeRows;  // rows of the full 3n system that are free
+  Eigen::MatrixXd K, M;
+  std::unique_ptr<StVKForceModel> model;
+
+  // A 0.6 x 0.1 x 0.15 bar (unequal sides: no repeated eigenvalues), two materials, clamped at
+  // x = 0 unless `free`.
+  explicit Problem(bool free) {
+    int size = 1;
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    mesh = makeBoxMesh({0.6, 0.1, 0.15}, {6, 1, 2});
+    for (int t = 0; t < mesh.tetCount(); ++t) {
+      Material m;
+      m.youngsModulus = t % 3 ? 1e6 : 3e6;
+      m.poissonRatio = 0.4;
+      m.density = t % 2 ? 1000 : 1300;
+      perTet.push_back(m);
+    }
+    if (!free)
+      for (int v = 0; v < mesh.vertexCount(); ++v)
+        if (mesh.vertices[v].x() == 0) fixed.push_back(v);
+    partition = partitionMesh(mesh, {size});
+    layout = std::make_unique<DofLayout>(MPI_COMM_WORLD, partition.vertexPart, fixed);
+    system = assembleSystem(mesh, perTet, partition.tetPart, *layout);
+    if (free) rigid = rigidModes(mesh, system.mass, *layout);
+
+    model = std::make_unique<StVKForceModel>(mesh, perTet);
+    const Eigen::MatrixXd Kfull = model->tangentStiffness(Eigen::VectorXd::Zero(3 * mesh.vertexCount()));
+    const Eigen::MatrixXd Mfull = consistentMassMatrix(mesh, perTet);
+    for (int v = 0; v < mesh.vertexCount(); ++v)
+      if (!std::binary_search(fixed.begin(), fixed.end(), v))
+        for (int c = 0; c < 3; ++c) freeRows.push_back(3 * v + c);
+    K = Kfull(freeRows, freeRows);
+    M = Mfull(freeRows, freeRows);
+  }
+
+  // Local rows -> dense free-DOF vector(s) in vertex order, identical on every rank.
+  Eigen::MatrixXd dense(const Eigen::MatrixXd& local) const { return layout->gatherToAll(local)(freeRows, Eigen::all); }
+  Eigen::VectorXd fullVector(const Eigen::VectorXd& freeValues) const {
+    Eigen::VectorXd full = Eigen::VectorXd::Zero(3 * mesh.vertexCount());
+    full(freeRows) = freeValues;
+    return full;
+  }
+};
+
+double maxRelative(const std::vector<double>& a, const Eigen::VectorXd& b) {
+  double worst = 0;
+  for (size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]) / std::abs(b[i]));
+  return worst;
+}
+
+// How far X's columns stand from span(Y): max over columns of the M-norm of x - Y Y^T M x, for
+// M-orthonormal X and Y (the sine of the largest principal angle, accurate to round-off).
+double subspaceGap(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, const Eigen::MatrixXd& M) {
+  const Eigen::MatrixXd R = X - Y * (Y.transpose() * M * X);
+  return (R.transpose() * M * R).diagonal().cwiseMax(0.0).cwiseSqrt().maxCoeff();
+}
+
+} // namespace
+
+class BakeStages : public ::testing::TestWithParam<bool> {};
+
+TEST_P(BakeStages, ModesMatchADenseGeneralizedEigenSolve) {
+  const bool free = GetParam();
+  Problem p(free);
+  ModeSettings settings;
+  settings.count = 5;
+  LinearModes modes = computeLinearModes(p.system.stiffness, p.system.mass, *p.layout, settings, p.rigid);
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ref(p.K, p.M);
+  const int skip = free ? 6 : 0;
+  EXPECT_EQ(modes.rigidSkipped, skip);
+  const Eigen::VectorXd expected = ref.eigenvalues().segment(skip, 5);
+  EXPECT_LT(maxRelative(modes.eigenvalues, expected), 1e-8);
+  for (double r : modes.residuals) EXPECT_LT(r, 1e-8);
+  const Eigen::MatrixXd phi = p.dense(modes.vectors);
+  EXPECT_LT(subspaceGap(phi, ref.eigenvectors().middleCols(skip, 5), p.M), 1e-7);
+  EXPECT_LT((phi.transpose() * p.M * phi - Eigen::MatrixXd::Identity(5, 5)).cwiseAbs().maxCoeff(), 1e-10);
+}
+
+TEST_P(BakeStages, DerivativesSolveTheDenseSystem) {
+  const bool free = GetParam();
+  Problem p(free);
+  ModeSettings ms;
+  ms.count = 3;
+  LinearModes modes = computeLinearModes(p.system.stiffness, p.system.mass, *p.layout, ms, p.rigid);
+  ModalDerivatives d = computeModalDerivatives(p.mesh, p.perTet, p.partition.tetPart, p.system.stiffness,
+                                               p.system.mass, *p.layout, modes, p.rigid, DerivativeSettings{});
+  ASSERT_EQ(d.pairs.size(), 6u);
+  for (double r : d.residuals) EXPECT_LT(r, 1e-8);
+  const Eigen::MatrixXd phi = p.dense(modes.vectors), psi = p.dense(d.vectors);
+  // Reference: -K^+ d^2R[phi_i, phi_j] from the full-space model, M-orthogonal to rigid motions.
+  // Rigid motions built here from the vertex positions (translations, infinitesimal rotations).
+  Eigen::MatrixXd rigid(3 * p.mesh.vertexCount(), 6);
+  for (int v = 0; v < p.mesh.vertexCount(); ++v) {
+    const Eigen::Vector3d x = p.mesh.vertices[v];
+    rigid.block<3, 3>(3 * v, 0).setIdentity();
+    for (int a = 0; a < 3; ++a) rigid.block<3, 1>(3 * v, 3 + a) = Eigen::Vector3d::Unit(a).cross(x);
+  }
+  if (free) {
+    Eigen::LLT<Eigen::MatrixXd> gram(rigid.transpose() * p.M * rigid);
+    rigid = gram.matrixU().solve<Eigen::OnTheRight>(rigid);  // R U^{-1}: M-orthonormal
+    EXPECT_LT((rigid.transpose() * p.M * rigid - Eigen::MatrixXd::Identity(6, 6)).cwiseAbs().maxCoeff(), 1e-10);
+    EXPECT_LT(subspaceGap(rigid, p.dense(p.rigid), p.M), 1e-10);
+  }
+  for (size_t q = 0; q < d.pairs.size(); ++q) {
+    Eigen::VectorXd h;
+    p.model->forceHessianAtRest(p.fullVector(phi.col(d.pairs[q][0])), p.fullVector(phi.col(d.pairs[q][1])), h);
+    Eigen::VectorXd b = -h(p.freeRows);
+    Eigen::VectorXd x;
+    if (free) {
+      b -= p.M * rigid * (rigid.transpose() * b);
+      x = p.K.completeOrthogonalDecomposition().solve(b);
+      x -= rigid * (rigid.transpose() * p.M * x);
+    } else {
+      x = p.K.ldlt().solve(b);
+    }
+    EXPECT_LT((psi.col(q) - x).norm(), 1e-8 * x.norm()) << "pair " << d.pairs[q][0] << "," << d.pairs[q][1];
+  }
+}
+
+TEST_P(BakeStages, BasisIsTheDenseMassPcaAndMassOrthonormal) {
+  const bool free = GetParam();
+  Problem p(free);
+  ModeSettings ms;
+  ms.count = 3;
+  LinearModes modes = computeLinearModes(p.system.stiffness, p.system.mass, *p.layout, ms, p.rigid);
+  ModalDerivatives d = computeModalDerivatives(p.mesh, p.perTet, p.partition.tetPart, p.system.stiffness,
+                                               p.system.mass, *p.layout, modes, p.rigid, DerivativeSettings{});
+  BasisSettings bs;
+  bs.rank = 5;
+  ReducedBasis basis = buildBasis(p.system.mass, *p.layout, modes, d, bs);
+  const Eigen::MatrixXd U = p.dense(basis.vectors);
+  EXPECT_LT((U.transpose() * p.M * U - Eigen::MatrixXd::Identity(5, 5)).cwiseAbs().maxCoeff(), 1e-10);
+
+  // Dense mass-PCA of the same scaled set: with M = L L^T, the SVD of L^T A.
+  const Eigen::MatrixXd phi = p.dense(modes.vectors), psi = p.dense(d.vectors);
+  const double l1 = modes.eigenvalues[0];
+  Eigen::MatrixXd A(phi.rows(), 9);
+  for (int i = 0; i < 3; ++i) A.col(i) = phi.col(i) * l1 / modes.eigenvalues[i];
+  for (int q = 0; q < 6; ++q) {
+    const int i = d.pairs[q][0], j = d.pairs[q][1];
+    A.col(3 + q) = psi.col(q) * (i == j ? 1.0 : std::sqrt(2.0)) * l1 * l1 / (modes.eigenvalues[i] * modes.eigenvalues[j]);
+  }
+  Eigen::LLT<Eigen::MatrixXd> llt(p.M);
+  Eigen::MatrixXd LtA = llt.matrixU() * A;
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(LtA, Eigen::ComputeThinU);
+  const Eigen::MatrixXd Uref = llt.matrixU().solve(svd.matrixU().leftCols(5));
+  for (int i = 0; i < 5; ++i) EXPECT_NEAR(basis.singularValues[i], svd.singularValues()[i], 1e-9 * svd.singularValues()[0]);
+  EXPECT_LT(subspaceGap(U, Uref, p.M), 1e-7);
+}
+
+TEST(BakeStages, UserBasisIsMassOrthonormalisedAndFlagged) {
+  Problem p(false);
+  Eigen::MatrixXd raw = Eigen::MatrixXd::Zero(p.layout->localDofs(), 2);
+  raw.col(0).setConstant(1.0);
+  for (int i = 0; i < raw.rows(); ++i) raw(i, 1) = (i % 3) + 0.5;
+  bool wasOrthonormal = true;
+  ReducedBasis b = importBasis(p.system.mass, *p.layout, raw, wasOrthonormal);
+  EXPECT_FALSE(wasOrthonormal);
+  const Eigen::MatrixXd U = p.dense(b.vectors);
+  EXPECT_LT((U.transpose() * p.M * U - Eigen::Matrix2d::Identity()).cwiseAbs().maxCoeff(), 1e-10);
+  raw.col(1) = 2 * raw.col(0);
+  EXPECT_THROW(importBasis(p.system.mass, *p.layout, raw, wasOrthonormal), std::runtime_error);
+}
+
+INSTANTIATE_TEST_SUITE_P(FixedAndFree, BakeStages, ::testing::Values(false, true),
+                         [](const auto& param) { return param.param ? "free" : "clamped"; });
