@@ -65,14 +65,20 @@ Eigen::MatrixXd loadUserBasis(const BakeContext& ctx, const std::string& spec, c
     shape = a.shape;
     data = std::move(a.data);
   }
-  if (shape.size() != 2 || shape[0] != fileRows)
-    throw std::runtime_error(spec + ": a basis must have shape (3 x " + std::to_string(mesh.loadedVertex.size()) +
-                             " vertices, r) = (" + std::to_string(fileRows) + ", r)");
-  const int64_t r = shape[1];
+  // (3N, r) as numpy users write it, or (r, N, 3) as the archive stores vectors; N in file order.
+  const int64_t N = static_cast<int64_t>(mesh.loadedVertex.size());
+  const bool columns = shape.size() == 2 && shape[0] == fileRows;
+  const bool slices = shape.size() == 3 && shape[1] == N && shape[2] == 3;
+  if (!columns && !slices)
+    throw std::runtime_error(spec + ": a basis must have shape (3 x " + std::to_string(N) + " vertices, r) = (" +
+                             std::to_string(fileRows) + ", r), or (r, " + std::to_string(N) + ", 3)");
+  const int64_t r = columns ? shape[1] : shape[0];
   Eigen::MatrixXd full(3 * static_cast<int64_t>(mesh.fileVertex.size()), r);
   for (size_t v = 0; v < mesh.fileVertex.size(); ++v)
-    for (int c = 0; c < 3; ++c)
-      for (int64_t j = 0; j < r; ++j) full(3 * v + c, j) = data[(3 * mesh.fileVertex[v] + c) * r + j];
+    for (int c = 0; c < 3; ++c) {
+      const int64_t row = 3 * mesh.fileVertex[v] + c;
+      for (int64_t j = 0; j < r; ++j) full(3 * v + c, j) = columns ? data[row * r + j] : data[j * fileRows + row];
+    }
   return full;
 }
 
@@ -182,8 +188,10 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
       modes = readModes(archive, layout);
       return;
     }
+    ProgressMeter meter(ctx, "modes", "converged");
     ModeSettings settings;
     settings.count = s.modes;
+    settings.progress = meter.callback();
     modes = computeLinearModes(system.stiffness, system.mass, layout, settings, rigid);
     writeModes(archive, modes, layout, modesHash);
   });
@@ -191,6 +199,9 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   ctx.progress(std::string("modes: ") + (reused ? "reused, " : "") + std::to_string(s.modes) + " modes, " + fixed3(hz.front()) + " to " + fixed3(hz.back()) +
                " Hz, max residual " + fixed3(*std::max_element(modes.residuals.begin(), modes.residuals.end())) +
                " [" + fixed3(clock.last()) + " s]");
+  for (size_t i = 0; i < hz.size(); ++i)
+    ctx.progress("  mode " + std::to_string(i) + ": " + fixed3(hz[i]) + " Hz (lambda " + fixed3(modes.eigenvalues[i]) +
+                 "), residual " + fixed3(modes.residuals[i]));
 
   ReducedBasis basis;
   std::string basisSource = "modes+derivatives";
@@ -203,8 +214,11 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
         derivatives = readDerivatives(archive, layout);
         return;
       }
+      ProgressMeter meter(ctx, "derivatives", "solved");
+      DerivativeSettings settings;
+      settings.progress = meter.callback();
       derivatives = computeModalDerivatives(mesh.mesh, perTet, partition.tetPart, system.stiffness, system.mass,
-                                            layout, modes, rigid, DerivativeSettings{});
+                                            layout, modes, rigid, settings);
       writeDerivatives(archive, derivatives, layout, derivativesHash);
     });
     ctx.progress(std::string("derivatives: ") + (reused ? "reused, " : "") + std::to_string(derivatives.pairs.size()) +
@@ -256,6 +270,7 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   archive.close();
   ctx.onRankZero([&] { fs::rename(partialPath, finalPath); });
   ctx.progress("wrote " + finalPath + " and " + s.output + ".xmf");
+  ctx.warnUnusedOptions();
 }
 
 } // namespace quiver

@@ -47,6 +47,16 @@ void BakeContext::progress(const std::string& message) const {
   if (rank_ == 0 && !quiet) std::cout << "quiver-bake: " << message << std::endl;
 }
 
+void BakeContext::warnUnusedOptions() const {
+  PetscInt count = 0;
+  char** names = nullptr;
+  char** values = nullptr;
+  if (PetscOptionsLeftGet(nullptr, &count, &names, &values) != 0) return;
+  for (PetscInt i = 0; i < count; ++i)
+    if (rank_ == 0) std::cerr << "quiver-bake: warning: option -" << names[i] << " was not used (misspelt?)" << std::endl;
+  PetscOptionsLeftRestore(nullptr, &count, &names, &values);
+}
+
 void BakeContext::onRankZero(const std::function<void()>& work) const {
   std::string error;
   if (rank_ == 0) {

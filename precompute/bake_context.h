@@ -25,6 +25,9 @@ public:
   // Rank 0 prints "quiver-bake: <message>" to stdout unless quiet.
   void progress(const std::string& message) const;
 
+  // Rank 0 warns about PETSc/SLEPc options that nothing read (usually a typo: -eps_tl).
+  void warnUnusedOptions() const;
+
   // Collective: runs `work` on rank 0 only (file writes that one process does for all), then every
   // rank throws std::runtime_error with rank 0's message if it failed, so no rank is left waiting.
   void onRankZero(const std::function<void()>& work) const;

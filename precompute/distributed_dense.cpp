@@ -2,11 +2,15 @@
 
 namespace quiver {
 
-PetscMat wrapDense(Eigen::MatrixXd& local, const DofLayout& layout) {
+PetscMat wrapDenseColumns(Eigen::MatrixXd& local, Eigen::Index first, Eigen::Index count, const DofLayout& layout) {
   PetscMat D;
   QV_PETSC(MatCreateDense(layout.comm(), layout.localDofs(), PETSC_DECIDE, layout.globalDofs(),
-                          static_cast<PetscInt>(local.cols()), local.data(), D.out()));
+                          static_cast<PetscInt>(count), local.data() + first * local.rows(), D.out()));
   return D;
+}
+
+PetscMat wrapDense(Eigen::MatrixXd& local, const DofLayout& layout) {
+  return wrapDenseColumns(local, 0, local.cols(), layout);
 }
 
 Eigen::MatrixXd multiply(Mat A, const Eigen::MatrixXd& X, const DofLayout& layout) {

@@ -11,6 +11,8 @@ namespace quiver {
 
 // A PETSc MPIDENSE matrix that shares `local`'s storage (no copy); `local` must outlive it.
 PetscMat wrapDense(Eigen::MatrixXd& local, const DofLayout& layout);
+// The same for columns [first, first + count) of `local`.
+PetscMat wrapDenseColumns(Eigen::MatrixXd& local, Eigen::Index first, Eigen::Index count, const DofLayout& layout);
 
 // This rank's rows of A X, for a distributed sparse A and row-distributed X. Collective.
 Eigen::MatrixXd multiply(Mat A, const Eigen::MatrixXd& X, const DofLayout& layout);

@@ -128,8 +128,14 @@ ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<
   QV_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   QV_PETSC(KSPSetFromOptions(ksp));
   out.vectors.resize(layout.localDofs(), static_cast<Eigen::Index>(out.pairs.size()));
-  PetscMat rhs = wrapDense(solveFor, layout), solution = wrapDense(out.vectors, layout);
-  QV_PETSC(KSPMatSolve(ksp, rhs, solution));
+  const Eigen::Index total = out.vectors.cols();
+  for (Eigen::Index first = 0; first < total; first += settings.blockSize) {
+    const Eigen::Index count = std::min<Eigen::Index>(settings.blockSize, total - first);
+    PetscMat rhs = wrapDenseColumns(solveFor, first, count, layout);
+    PetscMat solution = wrapDenseColumns(out.vectors, first, count, layout);
+    QV_PETSC(KSPMatSolve(ksp, rhs, solution));
+    if (settings.progress) settings.progress(first + count, total);
+  }
   if (freeObject) out.vectors -= rigid * innerProducts(rigid, multiply(mass, out.vectors, layout), layout.comm());
 
   // Residual against the unpinned system and the projected right-hand side.

@@ -13,12 +13,15 @@
 
 #include "common/tet_mesh.h"
 #include "precompute/dof_layout.h"
+#include "precompute/progress_meter.h"
 #include "precompute/stages/modes.h"
 
 namespace quiver {
 
 struct DerivativeSettings {
   double maxResidual = 1e-8;  // refuse solutions with ||K Psi - b|| / ||b|| above this
+  int blockSize = 32;         // right-hand sides per solve call, so that progress can be reported
+  ProgressCallback progress;  // (solved, total); optional
 };
 
 struct ModalDerivatives {

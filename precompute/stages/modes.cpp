@@ -23,8 +23,21 @@ struct EigenPairs {
 
 // The `count` eigenpairs nearest `shift` by Krylov-Schur with shift-and-invert (MUMPS Cholesky),
 // M-orthogonal to `deflation`'s columns. `fromOptions` lets -eps_* / -st_* override the defaults.
+struct MonitorContext {
+  const ProgressCallback* progress;
+  int wanted;
+};
+
+// SLEPc monitor: passes the number of converged pairs on to the stage's progress callback.
+PetscErrorCode reportConverged(EPS, PetscInt, PetscInt converged, PetscScalar*, PetscScalar*, PetscReal*, PetscInt,
+                               void* context) {
+  const auto* c = static_cast<const MonitorContext*>(context);
+  (*c->progress)(converged, c->wanted);
+  return 0;
+}
+
 EigenPairs solveNearShift(Mat stiffness, Mat mass, const DofLayout& layout, double shift, int count, double tolerance,
-                          const Eigen::MatrixXd& deflation, bool fromOptions) {
+                          const Eigen::MatrixXd& deflation, bool fromOptions, const ProgressCallback& progress) {
   PetscEps eps;
   QV_PETSC(EPSCreate(layout.comm(), eps.out()));
   QV_PETSC(EPSSetOperators(eps, stiffness, mass));
@@ -55,6 +68,8 @@ EigenPairs solveNearShift(Mat stiffness, Mat mass, const DofLayout& layout, doub
     raw.push_back(deflationVecs[j]);
   }
   if (!raw.empty()) QV_PETSC(EPSSetDeflationSpace(eps, static_cast<PetscInt>(raw.size()), raw.data()));
+  MonitorContext monitor{&progress, count};
+  if (progress) QV_PETSC(EPSMonitorSet(eps, reportConverged, &monitor, nullptr));
   if (fromOptions) QV_PETSC(EPSSetFromOptions(eps));
   QV_PETSC(EPSSolve(eps));
 
@@ -137,10 +152,11 @@ LinearModes computeLinearModes(Mat stiffness, Mat mass, const DofLayout& layout,
     // K - sigma M is nearly singular for sigma just below 0: good enough to locate the first elastic
     // eigenvalue, not to compute modes accurately. Then solve again at half that value.
     const double first = solveNearShift(stiffness, mass, layout, -1e-8 * diagonalRatio(stiffness, mass), 1, 1e-6,
-                                        rigid, false).values[0];
+                                        rigid, false, ProgressCallback()).values[0];
     out.shift = -0.5 * first;
   }
-  EigenPairs pairs = solveNearShift(stiffness, mass, layout, out.shift, settings.count, settings.tolerance, rigid, true);
+  EigenPairs pairs =
+      solveNearShift(stiffness, mass, layout, out.shift, settings.count, settings.tolerance, rigid, true, settings.progress);
   out.eigenvalues = std::move(pairs.values);
   out.vectors = std::move(pairs.vectors);
   // SLEPc returns M-normalised vectors for GHEP; normalise again so the contract does not rest on it.

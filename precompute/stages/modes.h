@@ -12,6 +12,7 @@
 #include <petscmat.h>
 
 #include "precompute/dof_layout.h"
+#include "precompute/progress_meter.h"
 
 namespace quiver {
 
@@ -19,6 +20,7 @@ struct ModeSettings {
   int count = 20;            // k, elastic modes wanted (>= 1)
   double tolerance = 1e-12;  // SLEPc's convergence tolerance (-eps_tol overrides)
   double maxResidual = 1e-8; // refuse pairs with ||K phi - lambda M phi|| / (||K||_1 ||phi||) above this
+  ProgressCallback progress; // (converged, wanted) as SLEPc iterates; optional
 };
 
 struct LinearModes {
