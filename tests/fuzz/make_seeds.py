@@ -1,10 +1,13 @@
 #!/usr/bin/python3
 """Writes the fuzzers' seed corpus (tests/fuzz/seeds/<format>/) from one tiny box mesh, in every
-encoding meshio can produce, plus hand-written Vega, MFEM and .bou files and numpy's .npy files.
+encoding meshio can produce, plus hand-written Vega, MFEM and .bou files, numpy's .npy files and
+.qvr models written from formats/model/QVR.md independently of the C++ writer.
 Re-run after changing it: /usr/bin/python3 tests/fuzz/make_seeds.py"""
 import itertools
+import math
 import os
 import shutil
+import struct
 import tempfile
 
 import meshio
@@ -43,6 +46,67 @@ def write(fmt, name, **kwargs):
     folder = os.path.join(SEEDS, fmt)
     os.makedirs(folder, exist_ok=True)
     return os.path.join(folder, name)
+
+
+def fnv1a64(data, state=0xCBF29CE484222325):
+    for byte in data:
+        state = ((state ^ byte) * 0x100000001B3) & 0xFFFFFFFFFFFFFFFF
+    return state
+
+
+def qvr_file(sections, minor=0, header_extra=b""):
+    """A .qvr file (QVR.md): the header, the section table right after it, then each section
+    (type, flags, bytes) at the next multiple of 64 bytes, with zero padding."""
+    header_size = 64 + len(header_extra)
+    offsets, end = [], header_size + 32 * len(sections)
+    for _, _, data in sections:
+        offsets.append(-(-end // 64) * 64)
+        end = offsets[-1] + len(data)
+    table = b"".join(struct.pack("<IIQQQ", t, f, o, len(d), fnv1a64(d)) for (t, f, d), o in zip(sections, offsets))
+    header = b"\x89QVR\r\n\x1a\n" + struct.pack("<HHIIIQQQ8x", 1, minor, 0x01020304, header_size, len(sections),
+                                                 header_size, end, fnv1a64(table))
+    header += struct.pack("<Q", fnv1a64(header + header_extra))
+    out = bytearray(end)
+    out[:header_size + len(table)] = header + header_extra + table
+    for (_, _, data), offset in zip(sections, offsets):
+        out[offset:offset + len(data)] = data
+    return bytes(out)
+
+
+def qvr_sections(precision, with_tets):
+    """One tet of side 0.1 with r = 2: the sections of types 1-8 (and 9), as (type, flags, bytes)."""
+    rest = [(0.5, 0.0, -0.25), (0.6, 0.0, -0.25), (0.5, 0.1, -0.25), (0.5, 0.0, -0.15)]
+    triangles = [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3]  # outward, counter-clockwise
+    r, n, file_n = 2, len(rest), 5
+    eigenvalues = [400.0, 900.0]
+    # Energy monomials: (0,0) (0,1) (1,1); (0,0,0) (0,0,1) (0,1,1) (1,1,1); (0,0,0,0) ... (1,1,1,1).
+    energy = [200.0, 0.0, 450.0, 1.5, -2.0, 0.25, 3.0, 0.125, 0.5, -0.75, 1.0, 2.0]
+    basis = [0.5 * math.sin(row + 2 * j) for row in range(3 * n) for j in range(r)]
+    gravity = [0.1, -0.2, 0.0, 0.3, -0.4, 0.05]
+    density = 1000.0
+    lo = [min(p[a] for p in rest) for a in range(3)]
+    hi = [max(p[a] for p in rest) for a in range(3)]
+    info = struct.pack("<8I3d2I3d3d3dd", r, n, 1, len(triangles) // 3, file_n, len(eigenvalues), precision, 1,
+                       1e5, 0.3, density, 1, 0, density * 0.1 ** 3 / 6, 0.5, 0.01, *lo, *hi, 1 / 60)
+    info += bytes(192 - len(info))
+    f64 = lambda values: struct.pack(f"<{len(values)}d", *values)
+    u32 = lambda values: struct.pack(f"<{len(values)}I", *values)
+    sections = [(1, 0, info), (2, 0, f64(energy)),
+                (3, 0, f64(basis) if precision == 64 else struct.pack(f"<{len(basis)}f", *basis)),
+                (4, 0, f64([x for p in rest for x in p])), (5, 0, u32(triangles)), (6, 0, u32([3, 0, 1, 2])),
+                (7, 0, f64(gravity)), (8, 0, f64(eigenvalues))]
+    return sections + [(9, 0, u32([0, 1, 2, 3]))] if with_tets else sections
+
+
+def write_qvr_seeds():
+    open(write("qvr", "float32_tets.qvr"), "wb").write(qvr_file(qvr_sections(32, True)))
+    open(write("qvr", "float64.qvr"), "wb").write(qvr_file(qvr_sections(64, False)))
+    # The float32 model as a later minor version writes it might: a longer header, a longer
+    # MODEL_INFO, an unknown optional section, the sections in reverse order.
+    sections = qvr_sections(32, True)
+    sections[0] = (1, 0, sections[0][2] + struct.pack("<2d", 1.5, -2.5))
+    sections.insert(4, (200, 1, b"data of a later version"))
+    open(write("qvr", "newer_minor.qvr"), "wb").write(qvr_file(sections[::-1], 1, bytes(range(64))))
 
 
 def main():
@@ -90,6 +154,8 @@ def main():
         np.lib.format.write_array(f, np.arange(3.0), version=(2, 0))
     np.save(write("npy", "empty.npy"), np.zeros((0, 3)))
     np.save(write("npy", "int32.npy"), np.arange(4, dtype="<i4"))
+
+    write_qvr_seeds()
 
 
 if __name__ == "__main__":

@@ -1,0 +1,138 @@
+#pragma once
+// The .qvr runtime model (format 1.0, specified in formats/model/QVR.md): constants, the monomial
+// order of the energy coefficients, and the reader. Standard library only and exception-free, so
+// that the runtime compiles qvr_reader.cpp into itself; the bake-side writer is qvr_writer.h.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace quiver {
+
+namespace qvr {
+
+constexpr unsigned char kMagic[8] = {0x89, 'Q', 'V', 'R', '\r', '\n', 0x1a, '\n'};
+constexpr unsigned char kEndianTag[4] = {0x04, 0x03, 0x02, 0x01};  // u32 0x01020304, little-endian
+constexpr uint16_t kVersionMajor = 1;
+constexpr uint16_t kVersionMinor = 0;
+constexpr size_t kHeaderSize = 64;         // of version 1.0; later minors may write more
+constexpr size_t kSectionEntrySize = 32;
+constexpr size_t kSectionAlignment = 64;   // every section offset is a multiple of this
+constexpr uint32_t kMaxSections = 64;
+constexpr size_t kModelInfoSize = 192;     // of version 1.0; later minors may append fields
+constexpr uint32_t kMaxBasisSize = 256;    // r
+constexpr uint32_t kOptionalSection = 1;   // section flag bit 0: readers that do not know the type skip it
+constexpr uint32_t kEnergyMonomials = 1;   // ModelInfo::coefficientLayout
+
+// Byte offsets of the header fields (bytes 0-7 are the magic, 48-55 are reserved).
+constexpr size_t kMajorAt = 8, kMinorAt = 10, kEndianTagAt = 12, kHeaderSizeAt = 16, kSectionCountAt = 20,
+                 kTableOffsetAt = 24, kFileSizeAt = 32, kTableChecksumAt = 40, kHeaderChecksumAt = 56;
+// Byte offsets of the fields of a section table entry.
+constexpr size_t kTypeAt = 0, kFlagsAt = 4, kOffsetAt = 8, kSizeAt = 16, kChecksumAt = 24;
+
+enum SectionType : uint32_t {
+  kModelInfo = 1,
+  kEnergyCoefficients = 2,
+  kBasis = 3,
+  kRestPositions = 4,
+  kSurfaceTriangles = 5,
+  kVertexMap = 6,
+  kGravityProjection = 7,
+  kEigenvalues = 8,
+  kTets = 9,  // the only section a file may omit
+};
+
+} // namespace qvr
+
+// Energy monomials (coefficientLayout 1). The reduced elastic energy is
+//   E(q) = sum_{i<=j} c_ij q_i q_j + sum_{i<=j<=k} c_ijk q_i q_j q_k + sum_{i<=j<=k<=l} c_ijkl q_i q_j q_k q_l
+// over indices in [0, r). The coefficients are stored degree by degree, each degree's sorted index
+// tuples in lexicographic order: (0,0), (0,1), ..., (0,r-1), (1,1), ..., (r-1,r-1).
+// monomialCountD(r) is the number of degree-D monomials, C(r+D-1, D). Exact for r < 2^15.
+constexpr size_t monomialCount2(uint64_t r) { return static_cast<size_t>(r * (r + 1) / 2); }
+constexpr size_t monomialCount3(uint64_t r) { return static_cast<size_t>(r * (r + 1) * (r + 2) / 6); }
+constexpr size_t monomialCount4(uint64_t r) { return static_cast<size_t>(r * (r + 1) * (r + 2) * (r + 3) / 24); }
+constexpr size_t energyCoefficientCount(uint64_t r) { return monomialCount2(r) + monomialCount3(r) + monomialCount4(r); }
+
+// Position of a monomial within its degree's block, for sorted indices i <= j <= k <= l < r. The
+// tuples before it are those starting below i (all tuples over [0, r) minus those over [i, r)),
+// then those starting with i, which are the shorter tuples over [i, r) shifted by i.
+constexpr size_t monomialIndex2(uint32_t r, uint32_t i, uint32_t j) {
+  return monomialCount2(r) - monomialCount2(r - i) + (j - i);
+}
+constexpr size_t monomialIndex3(uint32_t r, uint32_t i, uint32_t j, uint32_t k) {
+  return monomialCount3(r) - monomialCount3(r - i) + monomialIndex2(r - i, j - i, k - i);
+}
+constexpr size_t monomialIndex4(uint32_t r, uint32_t i, uint32_t j, uint32_t k, uint32_t l) {
+  return monomialCount4(r) - monomialCount4(r - i) + monomialIndex3(r - i, j - i, k - i, l - i);
+}
+
+// The MODEL_INFO section: counts, material and simulation defaults. Units are those of the baked
+// input (SI: m, kg, s, Pa). A reader validates every field as noted.
+struct ModelInfo {
+  uint32_t r = 0;                                // basis size, 1..256 and at most 3 vertexCount
+  uint32_t vertexCount = 0;                      // n, vertices of the simulated mesh, >= 4
+  uint32_t tetCount = 0;                         // m, >= 1
+  uint32_t triangleCount = 0;                    // surface triangles, >= 4
+  uint32_t fileVertexCount = 0;                  // vertices in the input mesh file, >= n
+  uint32_t eigenvalueCount = 0;                  // entries of EIGENVALUES, may be 0
+  uint32_t basisPrecision = 32;                  // bits per BASIS entry: 32 or 64
+  uint32_t coefficientLayout = qvr::kEnergyMonomials;  // 1, the only layout of version 1.0
+  double youngsModulus = 1e6;                    // E, Pa, > 0 (volume-weighted mean if mixed)
+  double poissonRatio = 0.45;                    // nu, in (-1, 0.5) (volume-weighted mean if mixed)
+  double density = 1000.0;                       // rho, kg/m^3, > 0 (volume-weighted mean if mixed)
+  uint32_t materialIsUniform = 1;                // 1: every tet has this material, 0: mixed
+  double totalMass = 0;                          // kg, > 0
+  double rayleighAlpha = 0;                      // default damping C = alpha I + beta K(q): 1/s, >= 0
+  double rayleighBeta = 0;                       // s, >= 0
+  double bboxMin[3] = {0, 0, 0};                 // componentwise min of REST_POSITIONS, exactly
+  double bboxMax[3] = {0, 0, 0};                 // componentwise max of REST_POSITIONS, exactly
+  double timeStep = 1.0 / 60.0;                  // suggested time step, s, > 0
+};
+
+// MODEL_INFO's byte layout, the one place it is written down in code: calls visit(byteOffset, field)
+// for every field. `Info` is ModelInfo or const ModelInfo. Bytes 60-63 and 144-191 are reserved.
+template <class Info, class Visit>
+void visitModelInfoFields(Info& info, Visit&& visit) {
+  visit(0, info.r);
+  visit(4, info.vertexCount);
+  visit(8, info.tetCount);
+  visit(12, info.triangleCount);
+  visit(16, info.fileVertexCount);
+  visit(20, info.eigenvalueCount);
+  visit(24, info.basisPrecision);
+  visit(28, info.coefficientLayout);
+  visit(32, info.youngsModulus);
+  visit(40, info.poissonRatio);
+  visit(48, info.density);
+  visit(56, info.materialIsUniform);
+  visit(64, info.totalMass);
+  visit(72, info.rayleighAlpha);
+  visit(80, info.rayleighBeta);
+  for (size_t a = 0; a < 3; ++a) visit(88 + 8 * a, info.bboxMin[a]);
+  for (size_t a = 0; a < 3; ++a) visit(112 + 8 * a, info.bboxMax[a]);
+  visit(136, info.timeStep);
+}
+
+// A validated model, pointing into the caller's buffer (nothing is copied: keep the buffer alive
+// and unchanged while the view is used). n = vertexCount, r = info.r.
+struct ModelView {
+  ModelInfo info;
+  uint16_t versionMinor = 0;                // of the file; fields of later minors are ignored
+  const double* energy = nullptr;           // energyCoefficientCount(r) coefficients, see above
+  const float* basis32 = nullptr;           // basisPrecision 32: U, 3n rows x r, row-major; else null
+  const double* basis64 = nullptr;          // basisPrecision 64: the same in float64; else null
+  const double* restPositions = nullptr;    // 3n: x, y, z of each vertex
+  const uint32_t* triangles = nullptr;      // 3 triangleCount vertex indices, counter-clockwise seen from outside
+  const uint32_t* vertexMap = nullptr;      // n: each vertex's index in the input mesh file
+  const double* gravity = nullptr;          // 3 x r: row a is U^T M e_a (e_a: unit acceleration along axis a)
+  const double* eigenvalues = nullptr;      // eigenvalueCount values
+  const uint32_t* tets = nullptr;           // 4 tetCount vertex indices; null when the file has no TETS
+};
+
+// Validates the .qvr file held in `data` (the whole file, `size` bytes, 8-byte aligned as malloc,
+// new and std::vector give) and on success fills `out` and returns true. On failure returns false
+// with `error` naming the section or field, its byte offset and what is wrong; `out` is then
+// left unchanged. Never throws (beyond std::bad_alloc while building a message); safe on any input.
+bool parseModel(const void* data, size_t size, ModelView& out, std::string& error);
+
+} // namespace quiver

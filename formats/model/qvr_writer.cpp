@@ -1,0 +1,125 @@
+#include "formats/model/qvr_writer.h"
+
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+
+#include "formats/atomic_file.h"
+#include "formats/model/fnv1a.h"
+
+namespace quiver {
+
+namespace {
+
+using namespace qvr;
+
+void storeLE(unsigned char* p, uint64_t v, size_t bytes) {
+  for (size_t i = 0; i < bytes; ++i) p[i] = static_cast<unsigned char>(v >> (8 * i));
+}
+
+void storeF64(unsigned char* p, double v) {
+  uint64_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  storeLE(p, bits, 8);
+}
+
+struct Piece {
+  SectionType type;
+  const void* data;
+  size_t size;
+};
+
+template <class T>
+Piece piece(SectionType type, const std::vector<T>& values) {
+  return {type, values.data(), values.size() * sizeof(T)};
+}
+
+size_t alignUp(size_t at) { return (at + kSectionAlignment - 1) / kSectionAlignment * kSectionAlignment; }
+
+} // namespace
+
+std::string formatModel(const ModelContents& c) {
+  unsigned char info[kModelInfoSize] = {};
+  visitModelInfoFields(c.info, [&info](size_t at, const auto& field) {
+    if constexpr (sizeof field == 4)
+      storeLE(info + at, field, 4);
+    else
+      storeF64(info + at, field);
+  });
+  std::vector<float> basis32;
+  if (c.info.basisPrecision == 32) {
+    basis32.resize(c.basis.size());
+    std::transform(c.basis.begin(), c.basis.end(), basis32.begin(), [](double v) { return static_cast<float>(v); });
+  }
+  std::vector<Piece> pieces = {{kModelInfo, info, sizeof info},
+                               piece(kEnergyCoefficients, c.energy),
+                               c.info.basisPrecision == 32 ? piece(kBasis, basis32) : piece(kBasis, c.basis),
+                               piece(kRestPositions, c.restPositions),
+                               piece(kSurfaceTriangles, c.triangles),
+                               piece(kVertexMap, c.vertexMap),
+                               piece(kGravityProjection, c.gravity),
+                               piece(kEigenvalues, c.eigenvalues)};
+  if (!c.tets.empty()) pieces.push_back(piece(kTets, c.tets));
+
+  const size_t tableSize = pieces.size() * kSectionEntrySize;
+  std::vector<size_t> offsets;
+  size_t end = kHeaderSize + tableSize;
+  for (const Piece& p : pieces) {
+    offsets.push_back(alignUp(end));
+    end = offsets.back() + p.size;
+  }
+  std::string bytes(end, '\0');
+  unsigned char* out = reinterpret_cast<unsigned char*>(bytes.data());
+  for (size_t i = 0; i < pieces.size(); ++i) {
+    const Piece& p = pieces[i];
+    if (p.size > 0) std::memcpy(out + offsets[i], p.data, p.size);
+    unsigned char* entry = out + kHeaderSize + i * kSectionEntrySize;
+    storeLE(entry + kTypeAt, p.type, 4);
+    storeLE(entry + kOffsetAt, offsets[i], 8);
+    storeLE(entry + kSizeAt, p.size, 8);
+    storeLE(entry + kChecksumAt, fnv1a64(p.data, p.size), 8);
+  }
+  std::memcpy(out, kMagic, sizeof kMagic);
+  storeLE(out + kMajorAt, kVersionMajor, 2);
+  storeLE(out + kMinorAt, kVersionMinor, 2);
+  std::memcpy(out + kEndianTagAt, kEndianTag, sizeof kEndianTag);
+  storeLE(out + kHeaderSizeAt, kHeaderSize, 4);
+  storeLE(out + kSectionCountAt, pieces.size(), 4);
+  storeLE(out + kTableOffsetAt, kHeaderSize, 8);
+  storeLE(out + kFileSizeAt, bytes.size(), 8);
+  storeLE(out + kTableChecksumAt, fnv1a64(out + kHeaderSize, tableSize), 8);
+  storeLE(out + kHeaderChecksumAt, fnv1a64(out, kHeaderChecksumAt), 8);
+
+  // The array bytes above were copied in this host's byte order; parseModel refuses big-endian
+  // hosts, so this check also keeps such a host from writing a wrong file.
+  ModelView view;
+  std::string error;
+  if (!parseModel(bytes.data(), bytes.size(), view, error))
+    throw std::runtime_error("cannot write a .qvr model: its contents are inconsistent: " + error);
+  return bytes;
+}
+
+void writeModelFile(const std::string& path, const ModelContents& contents) {
+  writeFileAtomically(path, formatModel(contents));
+}
+
+ModelContents copyModel(const ModelView& view) {
+  const ModelInfo& info = view.info;
+  const size_t r = info.r, n = info.vertexCount, basisSize = 3 * n * r;
+  ModelContents c;
+  c.info = info;
+  c.energy.assign(view.energy, view.energy + energyCoefficientCount(r));
+  if (view.basis32)
+    c.basis.assign(view.basis32, view.basis32 + basisSize);
+  else
+    c.basis.assign(view.basis64, view.basis64 + basisSize);
+  c.restPositions.assign(view.restPositions, view.restPositions + 3 * n);
+  c.triangles.assign(view.triangles, view.triangles + size_t{3} * info.triangleCount);
+  c.vertexMap.assign(view.vertexMap, view.vertexMap + n);
+  c.gravity.assign(view.gravity, view.gravity + 3 * r);
+  c.eigenvalues.assign(view.eigenvalues, view.eigenvalues + info.eigenvalueCount);
+  if (view.tets) c.tets.assign(view.tets, view.tets + size_t{4} * info.tetCount);
+  return c;
+}
+
+} // namespace quiver
