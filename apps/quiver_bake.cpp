@@ -13,7 +13,8 @@ int main(int argc, char** argv) {
   splitPetscOptions(argc, argv, own, petsc);
 
   CLI::App app{"quiver-bake: reduced St.Venant-Kirchhoff model of a tetrahedral mesh (Barbic & James 2005).\n"
-               "Writes NAME.h5 (every stage; schema in formats/ARCHIVE.md) and NAME.xmf (ParaView).\n"
+               "Writes NAME.qvr (the runtime model; formats/model/QVR.md), NAME.h5 (every stage; formats/ARCHIVE.md)\n"
+               "and NAME.xmf (ParaView).\n"
                "PETSc/SLEPc options pass through: -eps_tol, -eps_ncv, -st_*, -derivatives_pc_*, -log_view, ..."};
   app::MeshOptions meshOptions;
   app::FixedVertexOptions fixedOptions;
@@ -30,9 +31,15 @@ int main(int argc, char** argv) {
   app.add_option("--basis-from", s.basisFrom,
                  "Use this basis instead of modes + derivatives: FILE.npy or FILE.h5:/dataset, shape (3 x vertices, r) "
                  "in the mesh file's vertex order");
+  app.add_option("--basis-precision", s.model.basisPrecision, "Bits per basis entry in NAME.qvr: 32 or 64")
+      ->capture_default_str();
+  app.add_option("--damping-ratio", s.model.dampingRatio,
+                 "Default damping stored in NAME.qvr: fraction of critical at the first mode (stiffness-proportional)")
+      ->capture_default_str();
+  app.add_option("--time-step", s.model.timeStep, "Suggested time step stored in NAME.qvr, in s")->capture_default_str();
   app.add_flag("--export-npy", s.exportNpy, "Also write NAME.eigenvalues.npy, NAME.modes.npy and NAME.U.npy (float64)");
   app.add_flag("--resume", s.resume, "Reuse the stages of NAME.h5.partial (or NAME.h5) whose inputs have not changed");
-  app.add_option("-o,--output", s.output, "Output name: writes NAME.h5 and NAME.xmf")->required();
+  app.add_option("-o,--output", s.output, "Output name: writes NAME.qvr, NAME.h5 and NAME.xmf")->required();
   app.add_flag("--quiet", quiet, "Print nothing but warnings and errors");
 
   std::vector<char*> ownArgv;

@@ -10,6 +10,7 @@
 #include "formats/npy.h"
 #include "precompute/archive/xdmf.h"
 #include "precompute/checkpoint.h"
+#include "precompute/distributed_dense.h"
 #include "precompute/input_hash.h"
 #include "precompute/rigid_modes.h"
 #include "precompute/stages/assemble.h"
@@ -114,6 +115,10 @@ void checkBakeSettings(const BakeSettings& s) {
                                 std::to_string(s.modes + s.modes * (s.modes + 1) / 2) + " vectors that " +
                                 std::to_string(s.modes) + " modes and their derivatives give; raise --modes");
   if (s.output.empty()) throw std::invalid_argument("-o NAME is required");
+  if (s.model.basisPrecision != 32 && s.model.basisPrecision != 64)
+    throw std::invalid_argument("--basis-precision must be 32 or 64");
+  if (!(s.model.dampingRatio >= 0)) throw std::invalid_argument("--damping-ratio must be >= 0");
+  if (!(s.model.timeStep > 0)) throw std::invalid_argument("--time-step must be > 0 s");
   const fs::path folder = fs::path(s.output).parent_path();
   if (!folder.empty() && !fs::is_directory(folder))
     throw std::invalid_argument("output folder '" + folder.string() + "' does not exist");
@@ -244,8 +249,37 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   ctx.progress("basis: r = " + std::to_string(basis.vectors.cols()) + ", max |U^T M U - I| = " +
                fixed3(basis.orthonormalityError) + " [" + fixed3(clock.last()) + " s]");
 
+  const Eigen::MatrixXd fullU = layout.gatherToAll(basis.vectors);
+  EnergyPolynomial energy;
+  const std::string polynomialHash = InputHash().add(storedInputHash(archive, "/basis")).add(std::string("polynomials 1")).hex();
+  clock.run("polynomials", [&] {
+    reused = reuse && storedInputHash(archive, "/polynomials") == polynomialHash;
+    if (reused) {
+      energy = readPolynomial(archive);
+      return;
+    }
+    ProgressMeter meter(ctx, "polynomials", "tets integrated (rank 0)");
+    PolynomialSettings settings;
+    settings.progress = meter.callback();
+    energy = computeEnergyPolynomial(ctx.comm(), mesh.mesh, perTet, partition.tetPart, fullU, settings);
+    writePolynomial(archive, energy, polynomialHash);
+  });
+  ctx.progress(std::string("polynomials: ") + (reused ? "reused, " : "") + std::to_string(energy.coefficients.size()) +
+               " energy coefficients (exact, r = " + std::to_string(energy.r) + "), " +
+               fixed3(1e6 * clock.last() / mesh.mesh.tetCount()) + " us per tet [" + fixed3(clock.last()) + " s]");
+
+  clock.run("export", [&] {
+    // Gravity projection U^T M e_a: the reduced force of a unit acceleration along each axis.
+    Eigen::MatrixXd axes = Eigen::MatrixXd::Zero(layout.localDofs(), 3);
+    for (Eigen::Index i = 0; i < axes.rows(); ++i) axes(i, i % 3) = 1;
+    const Eigen::MatrixXd gravity = innerProducts(basis.vectors, multiply(system.mass, axes, layout), ctx.comm());
+    const ModelContents contents = makeModelContents(mesh, perTet, fullU, energy, modes.eigenvalues, gravity, s.model);
+    ctx.onRankZero([&] { writeModelFile(s.output + ".qvr", contents); });
+  });
+  ctx.progress("export: " + s.output + ".qvr [" + fixed3(clock.last()) + " s]");
+
   if (s.exportNpy) {
-    const Eigen::MatrixXd fullModes = layout.gatherToAll(modes.vectors), fullU = layout.gatherToAll(basis.vectors);
+    const Eigen::MatrixXd fullModes = layout.gatherToAll(modes.vectors);
     ctx.onRankZero([&] {
       const int64_t rows = 3 * static_cast<int64_t>(mesh.loadedVertex.size());
       writeNpy(s.output + ".eigenvalues.npy", {static_cast<int64_t>(modes.eigenvalues.size())}, modes.eigenvalues.data());
@@ -269,7 +303,7 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   ctx.onRankZero([&] { writeModesXdmf(s.output + ".xmf", h5Name, mesh.mesh.vertexCount(), mesh.mesh.tetCount(), fields); });
   archive.close();
   ctx.onRankZero([&] { fs::rename(partialPath, finalPath); });
-  ctx.progress("wrote " + finalPath + " and " + s.output + ".xmf");
+  ctx.progress("wrote " + s.output + ".qvr, " + finalPath + " and " + s.output + ".xmf");
   ctx.warnUnusedOptions();
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // The whole bake, stage after stage, on every rank of the BakeContext: load and check the mesh,
-// partition, assemble, modes, modal derivatives, basis; results go to NAME.h5 (written as
-// NAME.h5.partial and renamed when complete), NAME.xmf, and with exportNpy NAME.*.npy.
+// partition, assemble, modes, modal derivatives, basis, reduced polynomials; results go to NAME.qvr
+// (the runtime model), NAME.h5 (every stage, written as NAME.h5.partial and renamed when
+// complete), NAME.xmf, and with exportNpy NAME.*.npy.
 #include <string>
 #include <vector>
 
@@ -9,6 +10,7 @@
 #include "formats/mesh/fixed_vertices.h"
 #include "formats/mesh/mesh_checks.h"
 #include "precompute/bake_context.h"
+#include "precompute/stages/export_model.h"
 
 namespace quiver {
 
@@ -22,6 +24,7 @@ struct BakeSettings {
   int rank = 30;               // r, basis vectors
   std::string basisFrom;       // user basis: FILE.npy (3N x r) or FILE.h5:/dataset; "" for none
   bool exportNpy = false;      // also write NAME.eigenvalues.npy, NAME.modes.npy, NAME.U.npy
+  ExportSettings model;        // how NAME.qvr stores the basis, default damping and time step
   bool resume = false;         // reuse stages of NAME.h5.partial / NAME.h5 whose inputs hash the same
   std::string output;          // NAME
   std::string commandLine;     // for provenance

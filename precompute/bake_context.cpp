@@ -4,6 +4,7 @@
 #include <iostream>
 #include <stdexcept>
 
+#include <cblas.h>
 #include <slepcsys.h>
 
 namespace quiver {
@@ -39,6 +40,7 @@ BakeContext::BakeContext(std::vector<std::string> petscArgs) : argStorage_(std::
   if (SlepcInitialize(&argc, &argv, nullptr, nullptr) != 0) throw std::runtime_error("SLEPc/PETSc initialisation failed");
   MPI_Comm_rank(comm(), &rank_);
   MPI_Comm_size(comm(), &size_);
+  openblas_set_num_threads(1);  // parallelism comes from the ranks; threads on top would oversubscribe
 }
 
 BakeContext::~BakeContext() { SlepcFinalize(); }

@@ -156,4 +156,18 @@ ReducedBasis readBasis(const Archive& archive, const DofLayout& layout) {
   return b;
 }
 
+void writePolynomial(Archive& archive, const EnergyPolynomial& energy, const std::string& inputHash) {
+  resetGroup(archive, "/polynomials");
+  writeVector(archive, "/polynomials/energy_coefficients", energy.coefficients);
+  archive.setAttribute("/polynomials", "r", static_cast<int64_t>(energy.r));
+  finishGroup(archive, "/polynomials", inputHash);
+}
+
+EnergyPolynomial readPolynomial(const Archive& archive) {
+  EnergyPolynomial energy;
+  energy.r = static_cast<int>(archive.intAttribute("/polynomials", "r"));
+  energy.coefficients = readVector(archive, "/polynomials/energy_coefficients");
+  return energy;
+}
+
 } // namespace quiver

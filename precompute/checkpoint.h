@@ -12,6 +12,7 @@
 #include "precompute/stages/modal_derivatives.h"
 #include "precompute/stages/modes.h"
 #include "precompute/stages/partition.h"
+#include "precompute/stages/polynomials.h"
 
 namespace quiver {
 
@@ -33,6 +34,9 @@ ModalDerivatives readDerivatives(const Archive& archive, const DofLayout& layout
 void writeBasis(Archive& archive, const ReducedBasis& basis, const std::string& source, const DofLayout& layout,
                 const std::string& inputHash);
 ReducedBasis readBasis(const Archive& archive, const DofLayout& layout);
+
+void writePolynomial(Archive& archive, const EnergyPolynomial& energy, const std::string& inputHash);
+EnergyPolynomial readPolynomial(const Archive& archive);
 
 // Distributed vectors as (columns, vertices, 3) datasets, zeros at fixed DOFs. Collective.
 void writeVectors(Archive& archive, const std::string& dataset, const Eigen::MatrixXd& local, const DofLayout& layout);

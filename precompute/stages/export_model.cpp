@@ -1,0 +1,72 @@
+#include "precompute/stages/export_model.h"
+
+#include <cmath>
+
+#include "common/surface.h"
+
+namespace quiver {
+
+ModelContents makeModelContents(const CheckedMesh& mesh, const std::vector<Material>& perTet,
+                                const Eigen::MatrixXd& basis, const EnergyPolynomial& energy,
+                                const std::vector<double>& eigenvalues, const Eigen::MatrixXd& gravity,
+                                const ExportSettings& settings) {
+  const TetMesh& m = mesh.mesh;
+  const int r = static_cast<int>(basis.cols());
+  ModelContents c;
+  ModelInfo& info = c.info;
+  info.r = static_cast<uint32_t>(r);
+  info.vertexCount = static_cast<uint32_t>(m.vertexCount());
+  info.tetCount = static_cast<uint32_t>(m.tetCount());
+  info.fileVertexCount = static_cast<uint32_t>(mesh.loadedVertex.size());
+  info.eigenvalueCount = static_cast<uint32_t>(eigenvalues.size());
+  info.basisPrecision = static_cast<uint32_t>(settings.basisPrecision);
+
+  // Volume-weighted material means; uniform when every tet agrees.
+  double volume = 0, E = 0, nu = 0, rho = 0, mass = 0;
+  info.materialIsUniform = 1;
+  for (int t = 0; t < m.tetCount(); ++t) {
+    const double V = std::abs(signedVolume6(m, t)) / 6;
+    const Material& mat = perTet[t];
+    volume += V;
+    E += V * mat.youngsModulus;
+    nu += V * mat.poissonRatio;
+    rho += V * mat.density;
+    mass += V * mat.density;
+    const Material& first = perTet[0];
+    if (mat.youngsModulus != first.youngsModulus || mat.poissonRatio != first.poissonRatio ||
+        mat.density != first.density)
+      info.materialIsUniform = 0;
+  }
+  info.youngsModulus = E / volume;
+  info.poissonRatio = nu / volume;
+  info.density = rho / volume;
+  info.totalMass = mass;
+  // Stiffness-proportional damping beta K gives the mode of eigenvalue lambda the damping ratio
+  // beta sqrt(lambda) / 2: pick beta so the first mode gets dampingRatio.
+  info.rayleighAlpha = 0;
+  info.rayleighBeta = eigenvalues.empty() ? 0 : 2 * settings.dampingRatio / std::sqrt(eigenvalues[0]);
+  info.timeStep = settings.timeStep;
+  const auto box = boundingBox(m);
+  for (int a = 0; a < 3; ++a) {
+    info.bboxMin[a] = box[0][a];
+    info.bboxMax[a] = box[1][a];
+  }
+
+  c.energy = energy.coefficients;
+  c.basis.resize(basis.size());
+  for (Eigen::Index i = 0; i < basis.rows(); ++i)
+    for (int j = 0; j < r; ++j) c.basis[i * r + j] = basis(i, j);
+  for (const auto& x : m.vertices) c.restPositions.insert(c.restPositions.end(), {x.x(), x.y(), x.z()});
+  for (const auto& tri : boundaryTriangles(m))
+    for (int v : tri) c.triangles.push_back(static_cast<uint32_t>(v));
+  info.triangleCount = static_cast<uint32_t>(c.triangles.size() / 3);
+  c.vertexMap.assign(mesh.fileVertex.begin(), mesh.fileVertex.end());
+  for (int a = 0; a < 3; ++a)
+    for (int j = 0; j < r; ++j) c.gravity.push_back(gravity(j, a));
+  c.eigenvalues = eigenvalues;
+  for (const Tet& t : m.tets)
+    for (int v : t) c.tets.push_back(static_cast<uint32_t>(v));
+  return c;
+}
+
+} // namespace quiver
