@@ -37,9 +37,10 @@ ModelContents makeModelContents(const CheckedMesh& mesh, const std::vector<Mater
         mat.density != first.density)
       info.materialIsUniform = 0;
   }
-  info.youngsModulus = E / volume;
-  info.poissonRatio = nu / volume;
-  info.density = rho / volume;
+  // Uniform material: its exact values rather than means that round-off has touched.
+  info.youngsModulus = info.materialIsUniform ? perTet[0].youngsModulus : E / volume;
+  info.poissonRatio = info.materialIsUniform ? perTet[0].poissonRatio : nu / volume;
+  info.density = info.materialIsUniform ? perTet[0].density : rho / volume;
   info.totalMass = mass;
   // Stiffness-proportional damping beta K gives the mode of eigenvalue lambda the damping ratio
   // beta sqrt(lambda) / 2: pick beta so the first mode gets dampingRatio.

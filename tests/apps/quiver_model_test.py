@@ -1,0 +1,116 @@
+#!/usr/bin/python3
+"""A baked .qvr through `quiver info` / `quiver eval`, which run on the runtime library alone:
+sizes against the documented formula, the modal model's stiffness against the bake's eigenvalues,
+force and stiffness against finite differences of the energy, and damaged files refused."""
+import json
+import os
+import subprocess
+import tempfile
+import unittest
+
+import numpy as np
+
+BAKE = os.environ["QUIVER_BAKE"]
+MESH = os.environ["QUIVER_MESH"]
+QUIVER = os.environ["QUIVER"]
+MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
+
+
+def quiver(*args, ok=True):
+    p = subprocess.run([QUIVER, *map(str, args)], capture_output=True, text=True, timeout=60)
+    if ok:
+        assert p.returncode == 0, p.stderr
+        return json.loads(p.stdout)
+    return p
+
+
+def evaluate(model, q):
+    j = quiver("eval", model, "--q", ",".join(repr(float(x)) for x in q))
+    return j["energy"], np.array(j["force"]), np.array(j["stiffness"])
+
+
+class QuiverModel(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        d = cls.tmp.name
+        beam = os.path.join(d, "beam.vtu")
+        subprocess.run([MESH, "beam", "--size", "1,0.1,0.15", "--cells", "10,2,3", "-o", beam], check=True)
+        common = [beam, "--fix", "x<min+1e-9", "--E", "1e6", "--nu", "0.4", "--density", "1000", "--modes", "6"]
+        cls.full = os.path.join(d, "full")
+        cls.modal = os.path.join(d, "modal")
+        for name, extra in ((cls.full, ["--rank", "12", "--export-npy"]),
+                            (cls.modal, ["--basis-from", cls.full + ".modes.npy", "--basis-precision", "64"])):
+            p = subprocess.run([MPIEXEC, "-n", "2", "--oversubscribe", BAKE, *common, *extra, "-o", name, "--quiet"],
+                               capture_output=True, text=True, stdin=subprocess.DEVNULL, timeout=300)
+            assert p.returncode == 0, p.stderr
+        cls.eigenvalues = np.load(cls.full + ".eigenvalues.npy")
+
+    def test_info_counts_and_documented_sizes(self):
+        j = quiver("info", self.full + ".qvr")
+        r = 12
+        self.assertEqual((j["r"], j["vertices"], j["tets"]), (r, 11 * 3 * 4, 6 * 10 * 2 * 3))
+        self.assertEqual(j["surface_triangles"], 4 * (10 * 2 + 10 * 3 + 2 * 3))  # 2 per boundary cell face
+        c2, c3, c4 = r * (r + 1) // 2, r * (r + 1) * (r + 2) // 6, r * (r + 1) * (r + 2) * (r + 3) // 24
+        self.assertEqual(j["sections"]["ENERGY_COEFFICIENTS"], 8 * (c2 + c3 + c4))
+        vega = 8 * r * (r + r * (r + 1) // 2 + r * (r + 1) * (r + 2) // 6)  # Vega's .cub coefficient layout
+        self.assertLess(j["sections"]["ENERGY_COEFFICIENTS"], vega)
+        self.assertEqual(j["sections"]["BASIS"], 4 * 3 * j["vertices"] * r)  # float32 by default
+        np.testing.assert_allclose(j["frequencies_hz"], np.sqrt(self.eigenvalues) / (2 * np.pi), rtol=1e-12)
+        self.assertAlmostEqual(j["total_mass"], 1000 * 1 * 0.1 * 0.15, places=9)
+        self.assertEqual(j["material"]["poisson_ratio"], 0.4)
+
+    def test_modal_model_stiffness_at_rest_is_the_eigenvalues(self):
+        energy, force, K = evaluate(self.modal + ".qvr", np.zeros(6))
+        self.assertEqual(energy, 0.0)
+        self.assertEqual(np.abs(force).max(), 0.0)
+        np.testing.assert_allclose(K, np.diag(self.eigenvalues), atol=1e-10 * self.eigenvalues.max())
+
+    def test_force_and_stiffness_are_derivatives_of_the_energy(self):
+        rng = np.random.default_rng(1)
+        model = self.full + ".qvr"
+        q = rng.normal(size=12) * 0.02  # displacements of a few cm on a 1 m beam: cubic and quartic terms matter
+        _, force, K = evaluate(model, q)
+        np.testing.assert_allclose(K, K.T, atol=1e-12 * np.abs(K).max())
+        h = 1e-5
+        for i in range(12):
+            e = np.zeros(12)
+            e[i] = h
+            ep, fp, _ = evaluate(model, q + e)
+            em, fm, _ = evaluate(model, q - e)
+            self.assertLess(abs((ep - em) / (2 * h) - force[i]), 1e-6 * np.abs(force).max())
+            self.assertLess(np.abs((fp - fm) / (2 * h) - K[:, i]).max(), 1e-6 * np.abs(K).max())
+
+    def test_q_from_npy(self):
+        path = os.path.join(self.tmp.name, "q.npy")
+        q = np.linspace(-0.01, 0.01, 12)
+        np.save(path, q)
+        a = quiver("eval", self.full + ".qvr", "--q", path)
+        b = evaluate(self.full + ".qvr", q)
+        self.assertEqual(a["energy"], b[0])
+
+    def test_bad_arguments_and_damaged_files_are_refused_clearly(self):
+        model = self.full + ".qvr"
+        for q, message in (("1,2", "the model has r = 12"), ("1,x," + "0," * 9 + "0", "'x' is not a number")):
+            p = quiver("eval", model, "--q", q, ok=False)
+            self.assertEqual(p.returncode, 1)
+            self.assertIn(message, p.stderr)
+        with open(model, "rb") as f:
+            data = f.read()
+        damaged = os.path.join(self.tmp.name, "damaged.qvr")
+        for name, content, message in (("truncated", data[:len(data) // 2], "damaged.qvr"),
+                                       ("flipped", data[:5000] + bytes([data[5000] ^ 0x10]) + data[5001:], "checksum"),
+                                       ("empty", b"", "damaged.qvr")):
+            with self.subTest(name=name):
+                with open(damaged, "wb") as f:
+                    f.write(content)
+                p = quiver("info", damaged, ok=False)
+                self.assertEqual(p.returncode, 1)
+                self.assertIn(message, p.stderr)
+                self.assertIn("damaged.qvr", p.stderr)
+        p = quiver("info", os.path.join(self.tmp.name, "none.qvr"), ok=False)
+        self.assertIn("none.qvr: cannot open", p.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
