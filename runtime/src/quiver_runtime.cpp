@@ -4,6 +4,7 @@
 
 #include "model.cpp"
 #include "reduced_polynomial.cpp"
+#include "instance.cpp"
 
 #define QV_STR2(x) #x
 #define QV_STR(x) QV_STR2(x)

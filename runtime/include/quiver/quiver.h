@@ -103,6 +103,82 @@ QV_API const double* qv_model_gravity(const qv_model* model);
 /* Displacements u = U q of every vertex into `displacements` (3 floats per vertex). */
 QV_API qv_result qv_model_displacements(const qv_model* model, const double* q, float* displacements);
 
+/* ---- Simulation -------------------------------------------------------------------------
+   A qv_instance steps one object: M q'' + C q' + R(q) = f in the model's r reduced coordinates
+   (M = I: the basis is mass-orthonormal), with Rayleigh damping C = alpha I + beta K(q).
+   Instances share their model read-only; each may run on its own thread. qv_instance_step()
+   allocates nothing, takes no lock, throws nothing, and is deterministic: the same calls in the
+   same order give bit-identical states. */
+
+typedef enum qv_integrator {
+  QV_INTEGRATOR_IMPLICIT_NEWMARK = 0, /* beta = 1/4, gamma = 1/2 (Barbic & James 2005); unconditionally stable */
+  QV_INTEGRATOR_BACKWARD_EULER = 1,   /* implicit, first order, numerically damped */
+  QV_INTEGRATOR_CENTRAL_DIFFERENCES = 2 /* explicit; stable below qv_instance_stable_time_step() */
+} qv_integrator;
+
+typedef struct qv_instance_config {
+  qv_integrator integrator;  /* default QV_INTEGRATOR_IMPLICIT_NEWMARK */
+  double time_step;          /* s, > 0; default: the model's suggested step */
+  int newton_iterations;     /* implicit integrators, >= 1; default 1 (as Barbic & James) */
+  double rayleigh_alpha;     /* 1/s, >= 0; default: the model's */
+  double rayleigh_beta;      /* s, >= 0; default: the model's */
+  int max_constraints;       /* penalty constraint slots (drag springs, pinned groups), 0..64; default 4 */
+  double max_displacement;   /* m; a step that moves a vertex farther resets the instance; default 100 x the model's diagonal */
+} qv_instance_config;
+
+/* Defaults for `model` (pass NULL for model-independent defaults). */
+QV_API void qv_instance_config_init(qv_instance_config* config, const qv_model* model);
+
+typedef struct qv_instance qv_instance;
+
+/* Bytes (and alignment, 64) of the block an instance lives in, for qv_instance_create_in_place. */
+QV_API size_t qv_instance_memory_requirements(const qv_model* model, const qv_instance_config* config);
+/* Creates an instance in memory from `allocator` (NULL: the C heap), or in a caller-owned block of
+   at least qv_instance_memory_requirements() bytes, 64-byte aligned (destroy frees nothing then). */
+QV_API qv_result qv_instance_create(const qv_model* model, const qv_instance_config* config,
+                                    const qv_allocator* allocator, qv_instance** instance);
+QV_API qv_result qv_instance_create_in_place(const qv_model* model, const qv_instance_config* config, void* memory,
+                                             size_t size, qv_instance** instance);
+QV_API void qv_instance_destroy(qv_instance* instance);
+
+typedef enum qv_step_status {
+  QV_STEP_OK = 0,
+  QV_STEP_INDEFINITE = 1, /* the system matrix was indefinite (large compression); solved by pivoting LU instead */
+  QV_STEP_RESET = 2       /* the state became non-finite or exceeded max_displacement, or the solve failed:
+                             the instance was reset to rest */
+} qv_step_status;
+
+/* Advances one time step under the loads set so far; per-step loads are then cleared. */
+QV_API qv_step_status qv_instance_step(qv_instance* instance);
+
+/* Loads. Per-step (cleared by each step): a force on one vertex (N), a reduced force (r values).
+   Persistent: gravity (m/s^2), and penalty constraints pulling vertices toward targets with a
+   spring of `stiffness` (N/m) per vertex: one vertex dragged by the mouse, or a group held at
+   positions that a caller moves and rotates (drag and twist). */
+QV_API qv_result qv_instance_add_vertex_force(qv_instance* instance, int vertex, const double force[3]);
+QV_API qv_result qv_instance_add_reduced_force(qv_instance* instance, const double* force);
+QV_API void qv_instance_set_gravity(qv_instance* instance, const double acceleration[3]);
+QV_API qv_result qv_instance_set_constraint(qv_instance* instance, int slot, const int* vertices, int count,
+                                            const double* targets, double stiffness);
+QV_API void qv_instance_clear_constraint(qv_instance* instance, int slot);
+
+/* State (r values each; any pointer may be NULL), reset to rest, and energies (J). */
+QV_API void qv_instance_get_state(const qv_instance* instance, double* q, double* velocity, double* acceleration);
+QV_API void qv_instance_set_state(qv_instance* instance, const double* q, const double* velocity,
+                                  const double* acceleration);
+QV_API void qv_instance_reset(qv_instance* instance);
+QV_API void qv_instance_energies(const qv_instance* instance, double* kinetic, double* elastic);
+
+/* Largest stable time step of central differences at rest (2 / omega_max), s. */
+QV_API double qv_instance_stable_time_step(const qv_instance* instance);
+
+/* Output into caller-owned buffers: deformed positions X + U q (3 floats per vertex), of all
+   vertices or of the listed ones; and area-weighted vertex normals of the surface, computed
+   from `positions` of all vertices (3 floats per vertex; vertices off the surface get 0). */
+QV_API void qv_instance_positions(const qv_instance* instance, float* positions);
+QV_API qv_result qv_instance_positions_of(const qv_instance* instance, const int* vertices, int count, float* positions);
+QV_API void qv_model_surface_normals(const qv_model* model, const float* positions, float* normals);
+
 #ifdef __cplusplus
 }
 #endif

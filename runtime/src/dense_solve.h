@@ -1,0 +1,74 @@
+#pragma once
+// In-place solves of the small dense r x r systems of implicit time stepping, with no allocation:
+// Cholesky for the usual symmetric positive definite case, pivoting LU when large compression has
+// made the stiffness indefinite.
+#include <cmath>
+#include <cstddef>
+
+namespace quiver::rt {
+
+// Solves A x = b for symmetric positive definite A (row-major, n x n; overwritten by its factor).
+// b is overwritten by x. Returns false, leaving A and b spoiled, when A is not positive definite.
+inline bool choleskySolve(double* A, double* b, int n) {
+  for (int j = 0; j < n; ++j) {
+    double d = A[j * n + j];
+    for (int k = 0; k < j; ++k) d -= A[j * n + k] * A[j * n + k];
+    if (!(d > 0)) return false;
+    const double l = std::sqrt(d);
+    A[j * n + j] = l;
+    for (int i = j + 1; i < n; ++i) {
+      double s = A[i * n + j];
+      for (int k = 0; k < j; ++k) s -= A[i * n + k] * A[j * n + k];
+      A[i * n + j] = s / l;
+    }
+  }
+  for (int i = 0; i < n; ++i) {  // L y = b
+    double s = b[i];
+    for (int k = 0; k < i; ++k) s -= A[i * n + k] * b[k];
+    b[i] = s / A[i * n + i];
+  }
+  for (int i = n - 1; i >= 0; --i) {  // L^T x = y
+    double s = b[i];
+    for (int k = i + 1; k < n; ++k) s -= A[k * n + i] * b[k];
+    b[i] = s / A[i * n + i];
+  }
+  return true;
+}
+
+// Solves A x = b by LU with partial pivoting (A row-major, overwritten; b overwritten by x;
+// `pivot` holds n ints). Returns false when A is singular to working precision.
+inline bool luSolve(double* A, double* b, int* pivot, int n) {
+  double largest = 0;
+  for (int i = 0; i < n * n; ++i) largest = std::fmax(largest, std::fabs(A[i]));
+  for (int j = 0; j < n; ++j) {
+    int p = j;
+    for (int i = j + 1; i < n; ++i)
+      if (std::fabs(A[i * n + j]) > std::fabs(A[p * n + j])) p = i;
+    pivot[j] = p;
+    if (!(std::fabs(A[p * n + j]) > 1e-14 * largest)) return false;
+    if (p != j) {
+      for (int k = 0; k < n; ++k) {
+        const double t = A[j * n + k];
+        A[j * n + k] = A[p * n + k];
+        A[p * n + k] = t;
+      }
+      const double t = b[j];
+      b[j] = b[p];
+      b[p] = t;
+    }
+    for (int i = j + 1; i < n; ++i) {
+      const double f = A[i * n + j] / A[j * n + j];
+      A[i * n + j] = f;
+      for (int k = j + 1; k < n; ++k) A[i * n + k] -= f * A[j * n + k];
+      b[i] -= f * b[j];
+    }
+  }
+  for (int i = n - 1; i >= 0; --i) {
+    double s = b[i];
+    for (int k = i + 1; k < n; ++k) s -= A[i * n + k] * b[k];
+    b[i] = s / A[i * n + i];
+  }
+  return true;
+}
+
+} // namespace quiver::rt

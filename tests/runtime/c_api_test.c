@@ -1,0 +1,58 @@
+/* The C API from C: every call a C program (or an FFI) makes, on the suite's baked model.
+   Exits non-zero, naming the check, on the first failure. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "quiver/quiver.h"
+
+#define CHECK(condition)                                              \
+  do {                                                                \
+    if (!(condition)) {                                               \
+      fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #condition); \
+      return 1;                                                       \
+    }                                                                 \
+  } while (0)
+
+int main(int argc, char** argv) {
+  CHECK(argc == 2);
+  CHECK(QV_CHECK_VERSION());
+  CHECK(!qv_check_version(QV_VERSION_NUMBER + 1, sizeof(qv_model_info), sizeof(qv_allocator)));
+
+  qv_model* model = NULL;
+  char message[256];
+  CHECK(qv_model_load_file("/nonexistent.qvr", NULL, &model, message, sizeof message) == QV_ERROR_IO && !model);
+  CHECK(qv_model_load_file(argv[1], NULL, &model, message, sizeof message) == QV_OK && model);
+  qv_model_info info;
+  qv_model_get_info(model, &info);
+  CHECK(info.r > 0 && info.vertex_count > 0 && info.triangle_count > 0 && info.total_mass > 0);
+
+  qv_instance_config config;
+  qv_instance_config_init(&config, model);
+  CHECK(config.integrator == QV_INTEGRATOR_IMPLICIT_NEWMARK && config.newton_iterations == 1);
+  qv_instance* instance = NULL;
+  CHECK(qv_instance_create(model, &config, NULL, &instance) == QV_OK);
+  const double gravity[3] = {0, 0, -9.81};
+  qv_instance_set_gravity(instance, gravity);
+  for (int step = 0; step < 100; ++step) CHECK(qv_instance_step(instance) != QV_STEP_RESET);
+
+  float* positions = malloc(sizeof(float) * 3 * (size_t)info.vertex_count);
+  CHECK(positions);
+  qv_instance_positions(instance, positions);
+  double lowest = 1e300;
+  for (int v = 0; v < info.vertex_count; ++v) lowest = fmin(lowest, positions[3 * v + 2]);
+  CHECK(lowest < info.bbox_min[2]);  /* gravity pulled it down */
+  double kinetic = -1, elastic = -1;
+  qv_instance_energies(instance, &kinetic, &elastic);
+  CHECK(kinetic >= 0 && elastic > 0);
+  qv_instance_reset(instance);
+  qv_instance_energies(instance, &kinetic, &elastic);
+  CHECK(kinetic == 0 && elastic == 0);
+  CHECK(qv_result_string(QV_ERROR_FORMAT)[0] != '\0');
+
+  free(positions);
+  qv_instance_destroy(instance);
+  qv_model_destroy(model);
+  printf("c api: ok (r = %d)\n", info.r);
+  return 0;
+}

@@ -1,0 +1,135 @@
+// The real-time contract: after creation, stepping and reading positions never allocate (counted by
+// interposing malloc for the whole test binary), and all of the library's own memory goes
+// through the caller's allocator.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+
+#include "tests/runtime/runtime_fixture.h"
+
+extern "C" void* __libc_malloc(size_t);
+extern "C" void* __libc_calloc(size_t, size_t);
+extern "C" void* __libc_realloc(void*, size_t);
+extern "C" int __posix_memalign(void**, size_t, size_t);
+
+namespace {
+std::atomic<long> heapCalls{0};
+}
+
+// Every heap allocation in this process passes here (operator new too, through malloc).
+extern "C" void* malloc(size_t size) {
+  heapCalls.fetch_add(1, std::memory_order_relaxed);
+  return __libc_malloc(size);
+}
+extern "C" void* calloc(size_t n, size_t size) {
+  heapCalls.fetch_add(1, std::memory_order_relaxed);
+  return __libc_calloc(n, size);
+}
+extern "C" void* realloc(void* p, size_t size) {
+  heapCalls.fetch_add(1, std::memory_order_relaxed);
+  return __libc_realloc(p, size);
+}
+
+namespace {
+
+struct CountingAllocator {
+  long allocations = 0, releases = 0;
+  static void* allocate(size_t size, size_t alignment, void* user) {
+    ++static_cast<CountingAllocator*>(user)->allocations;
+    return std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
+  }
+  static void release(void* p, void* user) {
+    ++static_cast<CountingAllocator*>(user)->releases;
+    std::free(p);
+  }
+};
+
+} // namespace
+
+TEST(RealTime, StepAndOutputAllocateNothing) {
+  quiver::test::BakedModel m;
+  ASSERT_NE(m.model, nullptr);
+  CountingAllocator counter;
+  const qv_allocator allocator{CountingAllocator::allocate, CountingAllocator::release, &counter};
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  for (qv_integrator integrator :
+       {QV_INTEGRATOR_IMPLICIT_NEWMARK, QV_INTEGRATOR_BACKWARD_EULER, QV_INTEGRATOR_CENTRAL_DIFFERENCES}) {
+    config.integrator = integrator;
+    config.time_step = integrator == QV_INTEGRATOR_CENTRAL_DIFFERENCES ? 1e-4 : 1.0 / 60;
+    qv_instance* s = nullptr;
+    ASSERT_EQ(qv_instance_create(m.model, &config, &allocator, &s), QV_OK);
+    const int tip = m.tipVertex();
+    std::vector<float> positions(3 * m.info.vertex_count), normals(positions.size());
+    std::vector<double> reduced(m.info.r, 0.1);
+    const double g[3] = {0, 0, -9.81}, push[3] = {0, 1, 0}, target[3] = {0.6, 0.05, 0.1};
+    const long probe = heapCalls.load();
+    std::vector<int> allocates(16);
+    ASSERT_GT(heapCalls.load(), probe) << "malloc is not interposed: the count below would prove nothing";
+    const long before = heapCalls.load();
+    qv_instance_set_gravity(s, g);
+    qv_instance_set_constraint(s, 1, &tip, 1, target, 1e3);
+    for (int step = 0; step < 100; ++step) {
+      qv_instance_add_vertex_force(s, tip, push);
+      qv_instance_add_reduced_force(s, reduced.data());
+      qv_instance_step(s);
+      qv_instance_positions(s, positions.data());
+      qv_model_surface_normals(m.model, positions.data(), normals.data());
+    }
+    EXPECT_EQ(heapCalls.load() - before, 0) << "integrator " << integrator;
+    qv_instance_destroy(s);
+  }
+  EXPECT_EQ(counter.allocations, 3);  // one block per instance
+  EXPECT_EQ(counter.releases, 3);
+}
+
+TEST(RealTime, InstanceInCallerMemoryAndModelThroughCallerAllocator) {
+  quiver::test::BakedModel m;
+  ASSERT_NE(m.model, nullptr);
+  CountingAllocator counter;
+  const qv_allocator allocator{CountingAllocator::allocate, CountingAllocator::release, &counter};
+  qv_model* model = nullptr;
+  char message[256];
+  ASSERT_EQ(qv_model_load_file(QUIVER_RUNTIME_MODEL, &allocator, &model, message, sizeof message), QV_OK);
+  EXPECT_EQ(counter.allocations, 2);  // the file image, then the model's one block
+  EXPECT_EQ(counter.releases, 1);     // the image
+  qv_instance_config config;
+  qv_instance_config_init(&config, model);
+  const size_t bytes = qv_instance_memory_requirements(model, &config);
+  void* block = std::aligned_alloc(64, (bytes + 63) / 64 * 64);
+  qv_instance* s = nullptr;
+  EXPECT_EQ(qv_instance_create_in_place(model, &config, block, bytes - 1, &s), QV_ERROR_INVALID_ARGUMENT);
+  ASSERT_EQ(qv_instance_create_in_place(model, &config, block, bytes, &s), QV_OK);
+  EXPECT_EQ(qv_instance_step(s), QV_STEP_OK);
+  qv_instance_destroy(s);  // frees nothing: the block is the caller's
+  std::free(block);
+  qv_model_destroy(model);
+  EXPECT_EQ(counter.releases, 2);
+}
+
+TEST(RealTime, BadArgumentsAreRefusedNotCrashed) {
+  quiver::test::BakedModel m;
+  ASSERT_NE(m.model, nullptr);
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  qv_instance* s = nullptr;
+  qv_instance_config bad = config;
+  bad.time_step = -1;
+  EXPECT_EQ(qv_instance_create(m.model, &bad, nullptr, &s), QV_ERROR_INVALID_ARGUMENT);
+  bad = config;
+  bad.newton_iterations = 0;
+  EXPECT_EQ(qv_instance_create(m.model, &bad, nullptr, &s), QV_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(qv_instance_create(nullptr, &config, nullptr, &s), QV_ERROR_INVALID_ARGUMENT);
+  ASSERT_EQ(qv_instance_create(m.model, &config, nullptr, &s), QV_OK);
+  const double f[3] = {1, 0, 0};
+  EXPECT_EQ(qv_instance_add_vertex_force(s, -1, f), QV_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(qv_instance_add_vertex_force(s, m.info.vertex_count, f), QV_ERROR_INVALID_ARGUMENT);
+  const int v = 0;
+  EXPECT_EQ(qv_instance_set_constraint(s, config.max_constraints, &v, 1, f, 1), QV_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(qv_instance_set_constraint(s, 0, &v, 1, f, -1), QV_ERROR_INVALID_ARGUMENT);
+  qv_instance_destroy(s);
+  qv_model* model = nullptr;
+  EXPECT_EQ(qv_model_load_memory("not a model", 11, nullptr, &model, nullptr, 0), QV_ERROR_FORMAT);
+  EXPECT_EQ(model, nullptr);
+}
