@@ -9,6 +9,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <type_traits>
 
 #include "formats/model/fnv1a.h"
 
@@ -127,7 +128,7 @@ private:
   bool checkHeader() {
     const std::string header = "header";
     if (size_ < kHeaderSize)
-      return fail(header, 0, "the file has " + std::to_string(size_) + " bytes, fewer than the 64-byte header");
+      return fail(header, 0, "the file has " + std::to_string(size_) + " bytes, fewer than the " + std::to_string(kHeaderSize) + "-byte header");
     if (std::memcmp(data_, kMagic, 4) != 0) return fail(header, 0, "not a .qvr file (wrong magic bytes)");
     if (std::memcmp(data_, kMagic, sizeof kMagic) != 0)
       return fail(header, 4, "damaged magic bytes (line endings or ^Z changed: transferred in text mode?)");
@@ -157,7 +158,7 @@ private:
   bool readTable() {
     count_ = load32(data_ + kSectionCountAt);
     if (count_ == 0 || count_ > kMaxSections)
-      return fail("header", kSectionCountAt, "section count " + std::to_string(count_) + " is not in 1..64");
+      return fail("header", kSectionCountAt, "section count " + std::to_string(count_) + " is not in 1.." + std::to_string(kMaxSections));
     tableOffset_ = load64(data_ + kTableOffsetAt);
     const std::string table = "section table";
     if (tableOffset_ % 8 != 0) return fail(table, tableOffset_, "offset is not a multiple of 8");
@@ -185,7 +186,7 @@ private:
   }
 
   bool checkSection(Section& s) {
-    if (s.offset % kSectionAlignment != 0) return failIn(s, "offset is not a multiple of 64");
+    if (s.offset % kSectionAlignment != 0) return failIn(s, "offset is not a multiple of " + std::to_string(kSectionAlignment));
     if (s.offset > size_ || s.size > size_ - s.offset)
       return failIn(s, std::to_string(s.size) + " bytes run past the end of the file (" + std::to_string(size_) +
                            " bytes)");
@@ -239,17 +240,17 @@ private:
   bool readInfo(ModelInfo& info) {
     const Section& s = *byType_[kModelInfo];
     if (s.size < kModelInfoSize)
-      return failIn(s, "size " + std::to_string(s.size) + " is less than the 192 bytes of version 1.0");
+      return failIn(s, "size " + std::to_string(s.size) + " is less than the " + std::to_string(kModelInfoSize) + " bytes of version 1.0");
     const unsigned char* p = data_ + s.offset;
     visitModelInfoFields(info, [p](size_t at, auto& field) {
-      if constexpr (sizeof field == 4)
+      if constexpr (std::is_same_v<std::decay_t<decltype(field)>, uint32_t>)
         field = load32(p + at);
       else
         field = loadF64(p + at);
     });
     auto bad = [&](const std::string& what) { return failIn(s, what); };
     const std::string r = std::to_string(info.r), n = std::to_string(info.vertexCount);
-    if (info.r < 1 || info.r > kMaxBasisSize) return bad("r = " + r + " is not in 1..256");
+    if (info.r < 1 || info.r > kMaxBasisSize) return bad("r = " + r + " is not in 1.." + std::to_string(kMaxBasisSize));
     if (info.vertexCount < 4) return bad("vertexCount " + n + " is less than 4");
     if (info.r > uint64_t{3} * info.vertexCount) return bad("r = " + r + " exceeds 3 x vertexCount " + n);
     if (info.tetCount < 1) return bad("tetCount is 0");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 #include <stdexcept>
+#include <type_traits>
 
 #include "formats/atomic_file.h"
 #include "formats/model/fnv1a.h"
@@ -41,7 +42,7 @@ size_t alignUp(size_t at) { return (at + kSectionAlignment - 1) / kSectionAlignm
 std::string formatModel(const ModelContents& c) {
   unsigned char info[kModelInfoSize] = {};
   visitModelInfoFields(c.info, [&info](size_t at, const auto& field) {
-    if constexpr (sizeof field == 4)
+    if constexpr (std::is_same_v<std::decay_t<decltype(field)>, uint32_t>)
       storeLE(info + at, field, 4);
     else
       storeF64(info + at, field);

@@ -55,10 +55,12 @@ void expectHolds(const ModelView& v, const ModelContents& c) {
   EXPECT_EQ(bytesAt(v.vertexMap, n), test::arrayBytes(c.vertexMap));
   EXPECT_EQ(bytesAt(v.gravity, 3 * r), test::arrayBytes(c.gravity));
   EXPECT_EQ(bytesAt(v.eigenvalues, c.info.eigenvalueCount), test::arrayBytes(c.eigenvalues));
-  if (c.tets.empty())
+  if (c.tets.empty()) {
     EXPECT_EQ(v.tets, nullptr);
-  else
+  } else {
+    ASSERT_NE(v.tets, nullptr);
     EXPECT_EQ(bytesAt(v.tets, 4 * c.info.tetCount), test::arrayBytes(c.tets));
+  }
 }
 
 std::vector<Counts> variants() {

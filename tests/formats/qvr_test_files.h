@@ -1,6 +1,7 @@
 #pragma once
-// Helpers for the .qvr tests: synthetic models, and .qvr files assembled field by field from
-// QVR.md without the writer (independent little-endian encoding, explicit spec offsets).
+// Helpers for the .qvr tests and fuzz target: synthetic models, .qvr files assembled field by
+// field from QVR.md without the writer (independent little-endian encoding, explicit spec
+// offsets), and recomputing a damaged file's checksums so that checks behind them can be reached.
 #include <algorithm>
 #include <cstdint>
 #include <cstring>

@@ -17,22 +17,27 @@
 
 namespace {
 
-bool parseCopy(const std::string& bytes, quiver::ModelView& view, std::string& error) {
+// An exact-size copy from new (8-byte aligned), so that ASan reports any read past its end.
+std::unique_ptr<unsigned char[]> exactCopy(const std::string& bytes) {
   std::unique_ptr<unsigned char[]> copy(new unsigned char[bytes.size()]);
   if (!bytes.empty()) std::memcpy(copy.get(), bytes.data(), bytes.size());
-  return quiver::parseModel(copy.get(), bytes.size(), view, error);
+  return copy;
 }
 
 void check(const std::string& input) {
+  const std::unique_ptr<unsigned char[]> data = exactCopy(input);
   quiver::ModelView view;
   std::string error;
-  if (!parseCopy(input, view, error)) {
+  if (!quiver::parseModel(data.get(), input.size(), view, error)) {
     if (error.empty()) std::abort();
     return;
   }
   const std::string bytes = quiver::formatModel(quiver::copyModel(view));  // throws (aborts) when refused
+  const std::unique_ptr<unsigned char[]> formatted = exactCopy(bytes);
   quiver::ModelView again;
-  if (!parseCopy(bytes, again, error) || quiver::formatModel(quiver::copyModel(again)) != bytes) std::abort();
+  if (!quiver::parseModel(formatted.get(), bytes.size(), again, error) ||
+      quiver::formatModel(quiver::copyModel(again)) != bytes)
+    std::abort();
 }
 
 } // namespace
