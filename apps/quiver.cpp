@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "apps/sim_scenario.h"
 #include "formats/model/qvr.h"
 #include "formats/npy.h"
 #include "quiver/quiver.h"
@@ -20,7 +21,7 @@ struct ModelHandle {
   qv_model* model = nullptr;
   explicit ModelHandle(const std::string& path) {
     char message[1024] = "";
-    if (qv_model_load_file(path.c_str(), nullptr, &model, message, sizeof message) != QV_OK)
+    if (qv_model_load_file(path.c_str(), nullptr, nullptr, &model, message, sizeof message) != QV_OK)
       throw std::runtime_error(message);
   }
   ~ModelHandle() { qv_model_destroy(model); }
@@ -81,12 +82,17 @@ int main(int argc, char** argv) {
   CLI::App* eval = app.add_subcommand("eval", "Print the reduced energy, force and stiffness at q as JSON");
   eval->add_option("model", path, "Model file (.qvr)")->required();
   eval->add_option("--q", qText, "Reduced coordinates: r comma-separated numbers, or FILE.npy")->required();
+  CLI::App* sim = app.add_subcommand("sim", "Run a scripted scenario; write a .vtu series (.pvd), a CSV and timings");
+  quiver::app::SimOptions simOptions;
+  sim->add_option("model", path, "Model file (.qvr)")->required();
+  simOptions.addTo(*sim);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
   try {
+    if (*sim) return quiver::app::runScenario(path, simOptions);
     ModelHandle model(path);
     qv_model_info mi;
     qv_model_get_info(model.model, &mi);

@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
 
   qv_model* model = NULL;
   char message[512];
-  qv_result result = qv_model_load_file(argv[1], NULL, &model, message, sizeof message);
+  qv_result result = qv_model_load_file(argv[1], NULL, NULL, &model, message, sizeof message);
   if (result != QV_OK) {
     fprintf(stderr, "hello_quiver: %s: %s\n", qv_result_string(result), message);
     return 1;

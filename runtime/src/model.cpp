@@ -45,12 +45,14 @@ const T* place(char*& cursor, const T* source, size_t count) {
   return target;
 }
 
-qv_result build(const quiver::ModelView& view, const qv_allocator& allocator, qv_model** out) {
+qv_result build(const quiver::ModelView& view, const qv_model_config& config, const qv_allocator& allocator,
+                qv_model** out) {
+  const bool single = config.coefficient_precision == 32;
   const quiver::ModelInfo& in = view.info;
   const size_t r = in.r, n = in.vertexCount;
   const size_t basisBytes = 3 * n * r * (in.basisPrecision == 32 ? sizeof(float) : sizeof(double));
   const size_t bytes = roundUp(sizeof(qv_model)) +
-                       roundUp(quiver::rt::ReducedPolynomial::storageSize(in.r) * sizeof(double)) +
+                       roundUp(quiver::rt::ReducedPolynomial::storageBytes(in.r, single)) +
                        roundUp(basisBytes) + roundUp(3 * n * sizeof(double)) +
                        roundUp(3 * size_t(in.triangleCount) * sizeof(unsigned)) + roundUp(n * sizeof(unsigned)) +
                        roundUp(3 * r * sizeof(double)) + roundUp(size_t(in.eigenvalueCount) * sizeof(double));
@@ -65,9 +67,8 @@ qv_result build(const quiver::ModelView& view, const qv_allocator& allocator, qv
                           in.totalMass, in.rayleighAlpha, in.rayleighBeta, in.timeStep,
                           {in.bboxMin[0], in.bboxMin[1], in.bboxMin[2]}, {in.bboxMax[0], in.bboxMax[1], in.bboxMax[2]}};
   char* cursor = block + roundUp(sizeof(qv_model));
-  double* storage = reinterpret_cast<double*>(cursor);
-  cursor += roundUp(quiver::rt::ReducedPolynomial::storageSize(in.r) * sizeof(double));
-  m->polynomial.build(in.r, view.energy, storage);
+  m->polynomial.build(in.r, view.energy, single, cursor);
+  cursor += roundUp(quiver::rt::ReducedPolynomial::storageBytes(in.r, single));
   if (view.basis32)
     m->basis32 = place(cursor, view.basis32, 3 * n * r);
   else
@@ -85,15 +86,23 @@ qv_result build(const quiver::ModelView& view, const qv_allocator& allocator, qv
 
 extern "C" {
 
+void qv_model_config_init(qv_model_config* config) {
+  if (config) config->coefficient_precision = 64;
+}
+
 void qv_allocator_init(qv_allocator* allocator) {
   if (allocator) *allocator = qv_allocator{heapAllocate, heapRelease, nullptr};
 }
 
-qv_result qv_model_load_memory(const void* data, size_t size, const qv_allocator* allocator, qv_model** model,
-                               char* message, size_t message_size) {
+qv_result qv_model_load_memory(const void* data, size_t size, const qv_model_config* config,
+                               const qv_allocator* allocator, qv_model** model, char* message, size_t message_size) {
   if (!model) return QV_ERROR_INVALID_ARGUMENT;
   *model = nullptr;
-  if (!data && size) return QV_ERROR_INVALID_ARGUMENT;
+  qv_model_config defaults;
+  qv_model_config_init(&defaults);
+  const qv_model_config& settings = config ? *config : defaults;
+  if ((!data && size) || (settings.coefficient_precision != 32 && settings.coefficient_precision != 64))
+    return QV_ERROR_INVALID_ARGUMENT;
   qv_allocator heap;
   qv_allocator_init(&heap);
   const qv_allocator& use = allocator ? *allocator : heap;
@@ -109,15 +118,15 @@ qv_result qv_model_load_memory(const void* data, size_t size, const qv_allocator
   std::string error;
   qv_result result = QV_ERROR_FORMAT;
   if (quiver::parseModel(data, size, view, error))
-    result = build(view, use, model);
+    result = build(view, settings, use, model);
   else
     report(message, message_size, error);
   if (aligned) use.release(aligned, use.user);
   return result;
 }
 
-qv_result qv_model_load_file(const char* path, const qv_allocator* allocator, qv_model** model, char* message,
-                             size_t message_size) {
+qv_result qv_model_load_file(const char* path, const qv_model_config* config, const qv_allocator* allocator,
+                             qv_model** model, char* message, size_t message_size) {
   if (!model || !path) return QV_ERROR_INVALID_ARGUMENT;
   *model = nullptr;
   qv_allocator heap;
@@ -148,7 +157,7 @@ qv_result qv_model_load_file(const char* path, const qv_allocator* allocator, qv
     report(message, message_size, std::string(path) + ": read error");
   } else {
     char inner[512] = "";
-    result = qv_model_load_memory(buffer, static_cast<size_t>(length), &use, model, inner, sizeof inner);
+    result = qv_model_load_memory(buffer, static_cast<size_t>(length), config, &use, model, inner, sizeof inner);
     if (result != QV_OK) report(message, message_size, std::string(path) + ": " + inner);
   }
   use.release(buffer, use.user);

@@ -15,9 +15,9 @@ const char* qv_version_string(void) {
   return QV_STR(QV_VERSION_MAJOR) "." QV_STR(QV_VERSION_MINOR) "." QV_STR(QV_VERSION_PATCH);
 }
 
-int qv_check_version(int version_number, size_t model_info_size, size_t allocator_size) {
+int qv_check_version(int version_number, size_t model_info_size, size_t instance_config_size) {
   return version_number == QV_VERSION_NUMBER && model_info_size == sizeof(qv_model_info) &&
-         allocator_size == sizeof(qv_allocator);
+         instance_config_size == sizeof(qv_instance_config);
 }
 
 const char* qv_result_string(qv_result result) {

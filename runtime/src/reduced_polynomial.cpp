@@ -1,15 +1,24 @@
 #include "reduced_polynomial.h"
 
-#include <algorithm>
+#include <cstdint>
 #include <cstring>
 
 #include "formats/model/qvr.h"
+
+// The hot loops get AVX-512 and AVX2 versions chosen at run time where the compiler supports it;
+// define QUIVER_CROSS_PLATFORM_DETERMINISTIC to keep one code path (and so the same bits) on
+// every x86-64 machine.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__ELF__) && \
+    !defined(QUIVER_CROSS_PLATFORM_DETERMINISTIC)
+#define QV_HOT __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define QV_HOT
+#endif
 
 namespace quiver::rt {
 
 namespace {
 
-// Index of the sorted pair a <= b (lexicographic), the order shared by stiffness entries and z.
 inline size_t pairIndex(int r, int a, int b) { return monomialIndex2(r, a, b); }
 
 // Product of the factorials of how often each index repeats in a sorted tuple: the factor between
@@ -29,88 +38,160 @@ double repeatFactor(const int (&idx)[N]) {
   return f;
 }
 
-} // namespace
+size_t align8(size_t n) { return n & ~size_t(7); }
 
-size_t ReducedPolynomial::storageSize(int r) {
-  const size_t pairs = monomialCount2(r);
-  return pairs * (1 + static_cast<size_t>(r) + pairs);
+size_t packedCount(size_t pairs) {
+  size_t total = 0;
+  for (size_t p = 0; p < pairs; ++p) total += pairs - align8(p);
+  return total;
 }
 
-size_t ReducedPolynomial::scratchSize(int r) { return monomialCount2(r) * 4 + static_cast<size_t>(r); }
+size_t roundUp64(size_t bytes) { return (bytes + 63) & ~size_t(63); }
 
-void ReducedPolynomial::build(int r, const double* c, double* storage) {
+// y[s] += Q[p][s] x[p] for s > p and y[p] += sum_s Q[p][s] x[s]: one pass over row p of the upper
+// triangle does both halves of the symmetric product (the stored diagonal is halved).
+template <class C>
+QV_HOT void packedSymmetricProduct(const C* Q, const size_t* rowStart, const size_t* rowOffset, size_t n,
+                                   const double* x, double* y) {
+  for (size_t s = 0; s < n; ++s) y[s] = 0;
+  for (size_t p = 0; p < n; ++p) {
+    const C* row = Q + rowOffset[p] - rowStart[p];
+    const double xp = x[p];
+    double dot = 0;
+#pragma omp simd reduction(+ : dot)
+    for (size_t s = rowStart[p]; s < n; ++s) {
+      const double c = static_cast<double>(row[s]);
+      dot += c * x[s];
+      y[s] += c * xp;
+    }
+    y[p] += dot;
+  }
+}
+
+// y += sum_k q_k T_k over the rows T_k of length n.
+QV_HOT void sumOfRows(const double* T, int r, size_t n, const double* q, double* y) {
+  for (size_t s = 0; s < n; ++s) y[s] = 0;
+  for (int k = 0; k < r; ++k) {
+    const double* row = T + k * n;
+    const double qk = q[k];
+#pragma omp simd
+    for (size_t s = 0; s < n; ++s) y[s] += row[s] * qk;
+  }
+}
+
+} // namespace
+
+size_t ReducedPolynomial::storageBytes(int r, bool single) {
+  const size_t pairs = monomialCount2(r);
+  return roundUp64(pairs * sizeof(double)) + roundUp64(static_cast<size_t>(r) * pairs * sizeof(double)) +
+         2 * roundUp64(pairs * sizeof(size_t)) + roundUp64(packedCount(pairs) * (single ? sizeof(float) : sizeof(double)));
+}
+
+size_t ReducedPolynomial::scratchSize(int r) { return monomialCount2(r) * 5 + static_cast<size_t>(r); }
+
+void ReducedPolynomial::build(int r, const double* c, bool single, void* storage) {
   r_ = r;
   pairs_ = monomialCount2(r);
-  double* k2 = storage;
-  double* k3 = k2 + pairs_;
-  double* k4 = k3 + pairs_ * r;
-  std::memset(storage, 0, storageSize(r) * sizeof(double));
+  const size_t P = pairs_;
+  std::memset(storage, 0, storageBytes(r, single));
+  char* cursor = static_cast<char*>(storage);
+  auto take = [&](size_t bytes) {
+    char* p = cursor;
+    cursor += roundUp64(bytes);
+    return p;
+  };
+  double* k2 = reinterpret_cast<double*>(take(P * sizeof(double)));
+  double* t = reinterpret_cast<double*>(take(static_cast<size_t>(r) * P * sizeof(double)));
+  size_t* rowStart = reinterpret_cast<size_t*>(take(P * sizeof(size_t)));
+  size_t* rowOffset = reinterpret_cast<size_t*>(take(P * sizeof(size_t)));
+  void* Q = take(packedCount(P) * (single ? sizeof(float) : sizeof(double)));
+  for (size_t p = 0, offset = 0; p < P; ++p) {
+    rowStart[p] = align8(p);
+    rowOffset[p] = offset;
+    offset += P - rowStart[p];
+  }
+  auto setQ = [&](size_t p, size_t s, double value) {
+    if (s < p) {
+      const size_t x = p;
+      p = s;
+      s = x;
+    }
+    if (s == p) value *= 0.5;  // the product visits the diagonal twice
+    const size_t at = rowOffset[p] + (s - rowStart[p]);
+    if (single)
+      static_cast<float*>(Q)[at] = static_cast<float>(value);
+    else
+      static_cast<double*>(Q)[at] = value;
+  };
+
   const double* c2 = c;
   const double* c3 = c2 + monomialCount2(r);
   const double* c4 = c3 + monomialCount3(r);
   for (int a = 0; a < r; ++a)
     for (int b = a; b < r; ++b) k2[pairIndex(r, a, b)] = (a == b ? 2.0 : 1.0) * c2[monomialIndex2(r, a, b)];
   // Each monomial fixes the derivative tensor on every permutation of its indices: pick two of its
-  // positions as (a, b); the rest index the linear (k) or quadratic (k <= l) part of K_ab.
+  // positions as the pair (a, b); the rest index the linear (k) or quadratic (k <= l) part.
   for (int i = 0; i < r; ++i)
     for (int j = i; j < r; ++j)
       for (int k = j; k < r; ++k) {
         const int idx[3] = {i, j, k};
         const double T = c3[monomialIndex3(r, i, j, k)] * repeatFactor(idx);
         for (int x = 0; x < 3; ++x)
-          for (int y = x + 1; y < 3; ++y) k3[pairIndex(r, idx[x], idx[y]) * r + idx[3 - x - y]] = T;
+          for (int y = x + 1; y < 3; ++y) t[idx[3 - x - y] * P + pairIndex(r, idx[x], idx[y])] = T;
       }
   for (int i = 0; i < r; ++i)
     for (int j = i; j < r; ++j)
       for (int k = j; k < r; ++k)
         for (int l = k; l < r; ++l) {
           const int idx[4] = {i, j, k, l};
-          const double Q = c4[monomialIndex4(r, i, j, k, l)] * repeatFactor(idx);
+          const double value = c4[monomialIndex4(r, i, j, k, l)] * repeatFactor(idx);
           for (int x = 0; x < 4; ++x)
             for (int y = x + 1; y < 4; ++y) {
               int rest[2], n = 0;
               for (int s = 0; s < 4; ++s)
                 if (s != x && s != y) rest[n++] = idx[s];
-              // (1/2) sum_{k,l} Q q_k q_l counts k != l twice and k == l once.
-              k4[pairIndex(r, idx[x], idx[y]) * pairs_ + pairIndex(r, rest[0], rest[1])] = rest[0] == rest[1] ? 0.5 * Q : Q;
+              setQ(pairIndex(r, idx[x], idx[y]), pairIndex(r, rest[0], rest[1]), value);
             }
         }
   k2_ = k2;
-  k3_ = k3;
-  k4_ = k4;
+  t_ = t;
+  rowStart_ = rowStart;
+  rowOffset_ = rowOffset;
+  q64_ = single ? nullptr : static_cast<const double*>(Q);
+  q32_ = single ? static_cast<const float*>(Q) : nullptr;
 }
 
 void ReducedPolynomial::evaluate(const double* q, double* energy, double* force, double* stiffness,
                                  double* scratch) const {
   const int r = r_;
-  const size_t pairs = pairs_;
-  double* z = scratch;                 // q_k q_l, k <= l
-  double* K = z + pairs;               // stiffness, per pair
-  double* F = K + pairs;               // K_2 + K_3/2 + K_4/3, per pair
-  double* H = F + pairs;               // K_2/2 + K_3/6 + K_4/12, per pair
-  double* Rq = H + pairs;              // r
+  const size_t P = pairs_;
+  double* x = scratch;       // w_kl q_k q_l
+  double* y3 = x + P;        // K_3(q) per pair
+  double* y4 = y3 + P;       // K_4(q) per pair
+  double* F = y4 + P;        // K_2 + K_3/2 + K_4/3, per pair
+  double* H = F + P;         // K_2/2 + K_3/6 + K_4/12, per pair
+  double* Rq = H + P;        // r
   for (int k = 0, s = 0; k < r; ++k)
-    for (int l = k; l < r; ++l) z[s++] = q[k] * q[l];
-  for (size_t p = 0; p < pairs; ++p) {
-    const double* row3 = k3_ + p * r;
-    const double* row4 = k4_ + p * pairs;
-    double s3 = 0, s4 = 0;
-    for (int k = 0; k < r; ++k) s3 += row3[k] * q[k];
-    for (size_t s = 0; s < pairs; ++s) s4 += row4[s] * z[s];
-    K[p] = k2_[p] + s3 + s4;
-    F[p] = k2_[p] + s3 / 2 + s4 / 3;
-    H[p] = k2_[p] / 2 + s3 / 6 + s4 / 12;
-  }
-  std::fill(Rq, Rq + r, 0.0);
+    for (int l = k; l < r; ++l) x[s++] = (k == l ? 0.5 : 1.0) * q[k] * q[l];
+  if (q32_)
+    packedSymmetricProduct(q32_, rowStart_, rowOffset_, P, x, y4);
+  else
+    packedSymmetricProduct(q64_, rowStart_, rowOffset_, P, x, y4);
+  sumOfRows(t_, r, P, q, y3);
+  for (int i = 0; i < r; ++i) Rq[i] = 0;
   double e = 0;
   for (int a = 0, p = 0; a < r; ++a)
     for (int b = a; b < r; ++b, ++p) {
-      if (stiffness) stiffness[a * r + b] = stiffness[b * r + a] = K[p];
+      const double k2 = k2_[p], s3 = y3[p], s4 = y4[p];
+      if (stiffness) stiffness[a * r + b] = stiffness[b * r + a] = k2 + s3 + s4;
+      F[p] = k2 + s3 / 2 + s4 / 3;
+      H[p] = k2 / 2 + s3 / 6 + s4 / 12;
       Rq[a] += F[p] * q[b];
       if (b != a) Rq[b] += F[p] * q[a];
       e += (a == b ? 1.0 : 2.0) * H[p] * q[a] * q[b];
     }
-  if (force) std::copy(Rq, Rq + r, force);
+  if (force)
+    for (int i = 0; i < r; ++i) force[i] = Rq[i];
   if (energy) *energy = e;
 }
 

@@ -112,5 +112,57 @@ class QuiverModel(unittest.TestCase):
         self.assertIn("none.qvr: cannot open", p.stderr)
 
 
+class QuiverSim(unittest.TestCase):
+    """`quiver sim` as a user runs it: the files it promises, readable by an independent reader."""
+
+    @classmethod
+    def setUpClass(cls):
+        QuiverModel.setUpClass()
+        cls.model = QuiverModel.full + ".qvr"
+        cls.tmp = QuiverModel.tmp
+
+    def sim(self, *args, ok=True):
+        p = subprocess.run([QUIVER, "sim", self.model, *map(str, args)], capture_output=True, text=True, timeout=120)
+        if ok:
+            self.assertEqual(p.returncode, 0, p.stderr)
+        return p
+
+    def test_json_summary(self):
+        j = json.loads(self.sim("--steps", 50, "--hold", 20, "--force", "0,0,-2", "--json").stdout)
+        self.assertEqual((j["r"], j["steps"], j["resets"]), (12, 50, 0))
+        self.assertGreater(j["step_us_p99"], 0)
+        self.assertLessEqual(j["step_us_median"], j["step_us_p99"])
+
+    def test_series_csv_and_pvd(self):
+        out = os.path.join(self.tmp.name, "run", "pull")
+        self.sim("--steps", 40, "--hold", 20, "--force", "0,0,-2", "--gravity", "-o", out, "--every", 10)
+        with open(out + ".csv") as f:
+            rows = f.read().strip().split("\n")
+        self.assertEqual(len(rows), 41)
+        with open(out + ".pvd") as f:
+            self.assertEqual(f.read().count("<DataSet"), 4)
+        try:
+            import meshio
+        except ImportError:
+            self.skipTest("python3-meshio not installed")
+        frame = meshio.read(out + "_00020.vtu")
+        u = frame.point_data["displacement"]
+        self.assertLess(u[:, 2].min(), 0)  # pulled and pulled down
+        fixed = frame.points[:, 0] < 1e-9
+        self.assertLess(np.abs(u[fixed]).max(), 1e-6)  # the clamped end stays put (positions are float32)
+
+    def test_drag_and_twist_keeps_running(self):
+        j = json.loads(self.sim("--steps", 60, "--hold", 30, "--twist", 30, "--drag", "0,0.01,0", "--newton", 2,
+                                "--json").stdout)
+        self.assertEqual(j["resets"], 0)
+
+    def test_bad_options(self):
+        for args, message in ((["--group", "x<-5"], "selects no vertex"), (["--group", "q<1"], "--group"),
+                              (["--dt", "-1"], "--dt"), (["--newton", "0"], "invalid simulation settings")):
+            p = self.sim(*args, ok=False)
+            self.assertNotEqual(p.returncode, 0)
+            self.assertIn(message, p.stderr)
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)

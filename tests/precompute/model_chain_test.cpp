@@ -22,7 +22,7 @@ struct LoadedModel {
   std::vector<double> scratch;
   explicit LoadedModel(const std::string& bytes) {
     char message[512] = "";
-    EXPECT_EQ(qv_model_load_memory(bytes.data(), bytes.size(), nullptr, &model, message, sizeof message), QV_OK)
+    EXPECT_EQ(qv_model_load_memory(bytes.data(), bytes.size(), nullptr, nullptr, &model, message, sizeof message), QV_OK)
         << message;
     scratch.resize(qv_model_scratch_size(model) / sizeof(double) + 1);
   }

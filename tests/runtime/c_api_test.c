@@ -17,12 +17,12 @@
 int main(int argc, char** argv) {
   CHECK(argc == 2);
   CHECK(QV_CHECK_VERSION());
-  CHECK(!qv_check_version(QV_VERSION_NUMBER + 1, sizeof(qv_model_info), sizeof(qv_allocator)));
+  CHECK(!qv_check_version(QV_VERSION_NUMBER + 1, sizeof(qv_model_info), sizeof(qv_instance_config)));
 
   qv_model* model = NULL;
   char message[256];
-  CHECK(qv_model_load_file("/nonexistent.qvr", NULL, &model, message, sizeof message) == QV_ERROR_IO && !model);
-  CHECK(qv_model_load_file(argv[1], NULL, &model, message, sizeof message) == QV_OK && model);
+  CHECK(qv_model_load_file("/nonexistent.qvr", NULL, NULL, &model, message, sizeof message) == QV_ERROR_IO && !model);
+  CHECK(qv_model_load_file(argv[1], NULL, NULL, &model, message, sizeof message) == QV_OK && model);
   qv_model_info info;
   qv_model_get_info(model, &info);
   CHECK(info.r > 0 && info.vertex_count > 0 && info.triangle_count > 0 && info.total_mass > 0);

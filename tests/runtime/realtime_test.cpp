@@ -91,7 +91,7 @@ TEST(RealTime, InstanceInCallerMemoryAndModelThroughCallerAllocator) {
   const qv_allocator allocator{CountingAllocator::allocate, CountingAllocator::release, &counter};
   qv_model* model = nullptr;
   char message[256];
-  ASSERT_EQ(qv_model_load_file(QUIVER_RUNTIME_MODEL, &allocator, &model, message, sizeof message), QV_OK);
+  ASSERT_EQ(qv_model_load_file(QUIVER_RUNTIME_MODEL, nullptr, &allocator, &model, message, sizeof message), QV_OK);
   EXPECT_EQ(counter.allocations, 2);  // the file image, then the model's one block
   EXPECT_EQ(counter.releases, 1);     // the image
   qv_instance_config config;
@@ -130,6 +130,6 @@ TEST(RealTime, BadArgumentsAreRefusedNotCrashed) {
   EXPECT_EQ(qv_instance_set_constraint(s, 0, &v, 1, f, -1), QV_ERROR_INVALID_ARGUMENT);
   qv_instance_destroy(s);
   qv_model* model = nullptr;
-  EXPECT_EQ(qv_model_load_memory("not a model", 11, nullptr, &model, nullptr, 0), QV_ERROR_FORMAT);
+  EXPECT_EQ(qv_model_load_memory("not a model", 11, nullptr, nullptr, &model, nullptr, 0), QV_ERROR_FORMAT);
   EXPECT_EQ(model, nullptr);
 }

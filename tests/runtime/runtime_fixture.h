@@ -25,7 +25,7 @@ struct BakedModel {
   BakedModel() {
     const std::string path = QUIVER_RUNTIME_MODEL;
     char message[512] = "";
-    EXPECT_EQ(qv_model_load_file(path.c_str(), nullptr, &model, message, sizeof message), QV_OK) << message;
+    EXPECT_EQ(qv_model_load_file(path.c_str(), nullptr, nullptr, &model, message, sizeof message), QV_OK) << message;
     if (!model) return;
     qv_model_get_info(model, &info);
     std::ifstream in(path, std::ios::binary);

@@ -25,8 +25,8 @@ QV_API const char* qv_version_string(void);
 
 /* Non-zero when the library this program links was built from the headers it was compiled with
    (same version and struct sizes); call once at start-up as QV_CHECK_VERSION(). */
-QV_API int qv_check_version(int version_number, size_t model_info_size, size_t allocator_size);
-#define QV_CHECK_VERSION() qv_check_version(QV_VERSION_NUMBER, sizeof(qv_model_info), sizeof(qv_allocator))
+QV_API int qv_check_version(int version_number, size_t model_info_size, size_t instance_config_size);
+#define QV_CHECK_VERSION() qv_check_version(QV_VERSION_NUMBER, sizeof(qv_model_info), sizeof(qv_instance_config))
 
 typedef enum qv_result {
   QV_OK = 0,
@@ -70,14 +70,22 @@ typedef struct qv_model_info {
   double bbox_min[3], bbox_max[3];
 } qv_model_info;
 
+/* How a model is held in memory. Fill with qv_model_config_init(). */
+typedef struct qv_model_config {
+  int coefficient_precision; /* 64 (default): the baked coefficients exactly; 32: half the memory and
+                                faster steps, relative error of force and stiffness about 1e-7 */
+} qv_model_config;
+QV_API void qv_model_config_init(qv_model_config* config);
+
 /* Loads a .qvr file or a .qvr image in memory (copied; the caller may free it afterwards).
-   `allocator` may be NULL for the C heap. On failure *model is NULL and, when `message` is not
+   `config` and `allocator` may be NULL for the defaults and the C heap. On failure *model is NULL and, when `message` is not
    NULL, it receives a NUL-terminated description (file, section, offset, what is wrong),
    truncated to `message_size` bytes. */
-QV_API qv_result qv_model_load_file(const char* path, const qv_allocator* allocator, qv_model** model,
-                                    char* message, size_t message_size);
-QV_API qv_result qv_model_load_memory(const void* data, size_t size, const qv_allocator* allocator,
-                                      qv_model** model, char* message, size_t message_size);
+QV_API qv_result qv_model_load_file(const char* path, const qv_model_config* config, const qv_allocator* allocator,
+                                    qv_model** model, char* message, size_t message_size);
+QV_API qv_result qv_model_load_memory(const void* data, size_t size, const qv_model_config* config,
+                                      const qv_allocator* allocator, qv_model** model, char* message,
+                                      size_t message_size);
 QV_API void qv_model_destroy(qv_model* model);
 
 QV_API void qv_model_get_info(const qv_model* model, qv_model_info* info);
