@@ -3,16 +3,20 @@
 // as it is, and "repaired" (file size field and every checksum recomputed) so that mutations reach
 // the checks behind the checksums. A refusal must say why. An accepted model is copied element by
 // element through the view's pointers (ASan checks every one), must pass the writer's validation,
-// and must parse back to a model that formats to the same bytes; anything else aborts.
+// and must parse back to a model that formats to the same bytes; then the runtime loads it, and
+// evaluates and steps it once (so its load-time expansion and first step meet hostile numbers
+// too); anything else aborts.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "formats/model/qvr.h"
 #include "formats/model/qvr_writer.h"
+#include "quiver/quiver.h"
 #include "tests/formats/qvr_test_files.h"
 
 namespace {
@@ -22,6 +26,26 @@ std::unique_ptr<unsigned char[]> exactCopy(const std::string& bytes) {
   std::unique_ptr<unsigned char[]> copy(new unsigned char[bytes.size()]);
   if (!bytes.empty()) std::memcpy(copy.get(), bytes.data(), bytes.size());
   return copy;
+}
+
+// The runtime on an accepted model: load, evaluate at a small q, create an instance, one step.
+void runtimeSmoke(const void* data, size_t size) {
+  qv_model* model = nullptr;
+  char message[256];
+  if (qv_model_load_memory(data, size, nullptr, nullptr, &model, message, sizeof message) != QV_OK) std::abort();
+  qv_model_info info;
+  qv_model_get_info(model, &info);
+  std::vector<double> q(info.r, 1e-3), force(info.r), scratch(qv_model_scratch_size(model) / sizeof(double) + 1);
+  qv_model_evaluate(model, q.data(), nullptr, force.data(), nullptr, scratch.data());
+  qv_instance_config config;
+  qv_instance_config_init(&config, model);
+  qv_instance* instance = nullptr;
+  if (qv_instance_create(model, &config, nullptr, &instance) == QV_OK) {
+    qv_instance_set_state(instance, q.data(), nullptr, nullptr);
+    qv_instance_step(instance);
+    qv_instance_destroy(instance);
+  }
+  qv_model_destroy(model);
 }
 
 void check(const std::string& input) {
@@ -38,6 +62,7 @@ void check(const std::string& input) {
   if (!quiver::parseModel(formatted.get(), bytes.size(), again, error) ||
       quiver::formatModel(quiver::copyModel(again)) != bytes)
     std::abort();
+  runtimeSmoke(data.get(), input.size());
 }
 
 } // namespace
