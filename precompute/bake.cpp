@@ -93,6 +93,20 @@ std::vector<double> inFileOrder(const Eigen::MatrixXd& full, const CheckedMesh& 
   return out;
 }
 
+// A checkpointed stage: when resuming and the archive holds its results under the same input
+// hash they are read back; otherwise they are computed and written. Returns whether they were reused.
+template <class T, class Read, class Compute, class Write>
+bool reuseOrCompute(bool resume, const Archive& archive, const std::string& group, const std::string& hash, T& out,
+                    Read read, Compute compute, Write write) {
+  if (resume && storedInputHash(archive, group) == hash) {
+    out = read();
+    return true;
+  }
+  out = compute();
+  write(out);
+  return false;
+}
+
 std::string isoNow() {
   std::time_t t = std::time(nullptr);
   char buf[32];
@@ -188,17 +202,16 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   LinearModes modes;
   bool reused = false;
   clock.run("modes", [&] {
-    reused = reuse && storedInputHash(archive, "/modes") == modesHash;
-    if (reused) {
-      modes = readModes(archive, layout);
-      return;
-    }
-    ProgressMeter meter(ctx, "modes", "converged");
-    ModeSettings settings;
-    settings.count = s.modes;
-    settings.progress = meter.callback();
-    modes = computeLinearModes(system.stiffness, system.mass, layout, settings, rigid);
-    writeModes(archive, modes, layout, modesHash);
+    reused = reuseOrCompute(
+        reuse, archive, "/modes", modesHash, modes, [&] { return readModes(archive, layout); },
+        [&] {
+          ProgressMeter meter(ctx, "modes", "converged");
+          ModeSettings settings;
+          settings.count = s.modes;
+          settings.progress = meter.callback();
+          return computeLinearModes(system.stiffness, system.mass, layout, settings, rigid);
+        },
+        [&](const LinearModes& result) { writeModes(archive, result, layout, modesHash); });
   });
   const auto hz = modes.frequenciesHz();
   ctx.progress(std::string("modes: ") + (reused ? "reused, " : "") + std::to_string(s.modes) + " modes, " + fixed3(hz.front()) + " to " + fixed3(hz.back()) +
@@ -214,17 +227,16 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
     const std::string derivativesHash = InputHash().add(modesHash).add(std::string("derivatives 1")).hex();
     ModalDerivatives derivatives;
     clock.run("derivatives", [&] {
-      reused = reuse && storedInputHash(archive, "/derivatives") == derivativesHash;
-      if (reused) {
-        derivatives = readDerivatives(archive, layout);
-        return;
-      }
-      ProgressMeter meter(ctx, "derivatives", "solved");
-      DerivativeSettings settings;
-      settings.progress = meter.callback();
-      derivatives = computeModalDerivatives(mesh.mesh, perTet, partition.tetPart, system.stiffness, system.mass,
-                                            layout, modes, rigid, settings);
-      writeDerivatives(archive, derivatives, layout, derivativesHash);
+      reused = reuseOrCompute(
+          reuse, archive, "/derivatives", derivativesHash, derivatives, [&] { return readDerivatives(archive, layout); },
+          [&] {
+            ProgressMeter meter(ctx, "derivatives", "solved");
+            DerivativeSettings settings;
+            settings.progress = meter.callback();
+            return computeModalDerivatives(mesh.mesh, perTet, partition.tetPart, system.stiffness, system.mass, layout,
+                                           modes, rigid, settings);
+          },
+          [&](const ModalDerivatives& result) { writeDerivatives(archive, result, layout, derivativesHash); });
     });
     ctx.progress(std::string("derivatives: ") + (reused ? "reused, " : "") + std::to_string(derivatives.pairs.size()) +
                  " solved, max residual " +
@@ -253,16 +265,15 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   EnergyPolynomial energy;
   const std::string polynomialHash = InputHash().add(storedInputHash(archive, "/basis")).add(std::string("polynomials 1")).hex();
   clock.run("polynomials", [&] {
-    reused = reuse && storedInputHash(archive, "/polynomials") == polynomialHash;
-    if (reused) {
-      energy = readPolynomial(archive);
-      return;
-    }
-    ProgressMeter meter(ctx, "polynomials", "tets integrated (rank 0)");
-    PolynomialSettings settings;
-    settings.progress = meter.callback();
-    energy = computeEnergyPolynomial(ctx.comm(), mesh.mesh, perTet, partition.tetPart, fullU, settings);
-    writePolynomial(archive, energy, polynomialHash);
+    reused = reuseOrCompute(
+        reuse, archive, "/polynomials", polynomialHash, energy, [&] { return readPolynomial(archive); },
+        [&] {
+          ProgressMeter meter(ctx, "polynomials", "tets integrated (rank 0)");
+          PolynomialSettings settings;
+          settings.progress = meter.callback();
+          return computeEnergyPolynomial(ctx.comm(), mesh.mesh, perTet, partition.tetPart, fullU, settings);
+        },
+        [&](const EnergyPolynomial& result) { writePolynomial(archive, result, polynomialHash); });
   });
   ctx.progress(std::string("polynomials: ") + (reused ? "reused, " : "") + std::to_string(energy.coefficients.size()) +
                " energy coefficients (exact, r = " + std::to_string(energy.r) + "), " +

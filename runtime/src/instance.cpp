@@ -87,23 +87,24 @@ struct qv_instance {
     }
   }
 
-  // Builds system = I + c1 C + c2 (K + Kc) with C = alpha I + beta K (elastic part only) and
-  // solves system x = rhs in place (rhs becomes x).
-  qv_step_status solve(double c1, double c2) {
+  // system = I + c1 C + c2 (K + Kc), with C = alpha I + beta K (elastic part only).
+  void fillSystem(double c1, double c2) {
     const double alpha = config.rayleigh_alpha, beta = config.rayleigh_beta;
-    for (int i = 0; i < r; ++i)
-      for (int j = 0; j < r; ++j) {
-        const double k = stiffness[i * r + j];
-        system[i * r + j] = (c1 * beta + c2) * k + c2 * constraintK[i * r + j] + (i == j ? 1.0 + c1 * alpha : 0.0);
-      }
-    // The Cholesky attempt spoils `system`, so keep the right-hand side for a second try.
-    std::memcpy(next, rhs, sizeof(double) * r);
-    if (quiver::rt::choleskySolve(system, rhs, r)) return QV_STEP_OK;
-    std::memcpy(rhs, next, sizeof(double) * r);
     for (int i = 0; i < r; ++i)
       for (int j = 0; j < r; ++j)
         system[i * r + j] = (c1 * beta + c2) * stiffness[i * r + j] + c2 * constraintK[i * r + j] +
                             (i == j ? 1.0 + c1 * alpha : 0.0);
+  }
+
+  // Solves (I + c1 C + c2 (K + Kc)) x = rhs in place (rhs becomes x): Cholesky, or pivoting LU
+  // when large compression has made the matrix indefinite.
+  qv_step_status solve(double c1, double c2) {
+    fillSystem(c1, c2);
+    // The Cholesky attempt spoils `system` and `rhs`, so keep the right-hand side for a second try.
+    std::memcpy(next, rhs, sizeof(double) * r);
+    if (quiver::rt::choleskySolve(system, rhs, r)) return QV_STEP_OK;
+    std::memcpy(rhs, next, sizeof(double) * r);
+    fillSystem(c1, c2);
     return quiver::rt::luSolve(system, rhs, pivot, r) ? QV_STEP_INDEFINITE : QV_STEP_RESET;
   }
 
