@@ -1,0 +1,143 @@
+// The runtime's hot paths on baked models, single thread (Google Benchmark):
+//   Evaluate/force, Evaluate/force+stiffness, Step (implicit Newmark, 1 Newton iteration),
+//   and ManyObjects: 1000 instances of one model stepped per frame.
+// Peak FMA throughput of this core is measured in the same run (PeakFma) so that the evaluation
+// can be reported as a fraction of it. Each benchmark's label carries a hash of its final state.
+//   bench/runtime.py --build build/release     (bakes the models, runs this, prints the table)
+//   build/release/bench/bench_runtime MODEL.qvr [MODEL.qvr ...] [--benchmark_* flags]
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "formats/model/fnv1a.h"
+#include "formats/model/qvr.h"
+#include "quiver/quiver.h"
+
+namespace {
+
+std::string stateHash(const qv_instance* s, int r) {
+  std::vector<double> q(3 * static_cast<size_t>(r));
+  qv_instance_get_state(s, q.data(), q.data() + r, q.data() + 2 * r);
+  char text[20];
+  std::snprintf(text, sizeof text, "%016llx",
+                static_cast<unsigned long long>(quiver::fnv1a64(q.data(), q.size() * sizeof(double))));
+  return text;
+}
+
+// Floating-point operations of one evaluation, as the code performs them: the packed symmetric
+// product (2 multiply-adds per stored coefficient, about P(P+1)/2 of them), the cubic axpys
+// (r P multiply-adds) and the per-pair assembly (about 10 P).
+double evaluationFlops(int r) {
+  const double P = r * (r + 1) / 2.0;
+  return 4 * P * (P + 1) / 2 + 2 * r * P + 10 * P;
+}
+
+struct Loaded {
+  qv_model* model = nullptr;
+  qv_model_info info{};
+  explicit Loaded(const char* path) {
+    char message[512];
+    if (qv_model_load_file(path, nullptr, nullptr, &model, message, sizeof message) != QV_OK) {
+      std::fprintf(stderr, "%s\n", message);
+      std::exit(1);
+    }
+    qv_model_get_info(model, &info);
+  }
+};
+
+// 12 independent fused multiply-add chains of 8 doubles: what one core can sustain.
+typedef double v8 __attribute__((vector_size(64)));
+__attribute__((target("avx512f,fma"), noinline)) double fmaChains(long iterations) {
+  v8 acc[12];
+  const v8 a = {1.0000001, 1.0000001, 1.0000001, 1.0000001, 1.0000001, 1.0000001, 1.0000001, 1.0000001};
+  const v8 b = {1e-9, 1e-9, 1e-9, 1e-9, 1e-9, 1e-9, 1e-9, 1e-9};
+  for (auto& x : acc) x = b;
+  for (long i = 0; i < iterations; ++i)
+    for (auto& x : acc) x = x * a + b;
+  double sum = 0;
+  for (auto& x : acc)
+    for (int k = 0; k < 8; ++k) sum += x[k];
+  return sum;
+}
+
+void PeakFma(benchmark::State& state) {
+  const long iterations = 1 << 20;
+  for (auto _ : state) benchmark::DoNotOptimize(fmaChains(iterations));
+  state.counters["GFLOPS"] = benchmark::Counter(2.0 * 8 * 12 * iterations * state.iterations(),
+                                                benchmark::Counter::kIsRate, benchmark::Counter::kIs1000);
+}
+
+void Evaluate(benchmark::State& state, const char* path, bool withStiffness) {
+  Loaded m(path);
+  const int r = m.info.r;
+  std::vector<double> q(r), force(r), K(static_cast<size_t>(r) * r), scratch(qv_model_scratch_size(m.model) / 8 + 1);
+  for (int i = 0; i < r; ++i) q[i] = 1e-3 * (i + 1);
+  for (auto _ : state) {
+    qv_model_evaluate(m.model, q.data(), nullptr, force.data(), withStiffness ? K.data() : nullptr, scratch.data());
+    benchmark::DoNotOptimize(force.data());
+    q[0] += 1e-12;
+  }
+  state.counters["r"] = r;
+  state.counters["GFLOPS"] = benchmark::Counter(evaluationFlops(r) * state.iterations(), benchmark::Counter::kIsRate,
+                                                benchmark::Counter::kIs1000);
+  qv_model_destroy(m.model);
+}
+
+void Step(benchmark::State& state, const char* path) {
+  Loaded m(path);
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  qv_instance* s = nullptr;
+  qv_instance_create(m.model, &config, nullptr, &s);
+  const double g[3] = {0, 0, -9.81};
+  qv_instance_set_gravity(s, g);
+  for (auto _ : state) qv_instance_step(s);
+  state.counters["r"] = m.info.r;
+  state.SetLabel("state " + stateHash(s, m.info.r));
+  qv_instance_destroy(s);
+  qv_model_destroy(m.model);
+}
+
+void ManyObjects(benchmark::State& state, const char* path) {
+  Loaded m(path);
+  const int objects = static_cast<int>(state.range(0));
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  std::vector<qv_instance*> all(objects);
+  const double g[3] = {0, 0, -9.81};
+  for (auto& s : all) {
+    qv_instance_create(m.model, &config, nullptr, &s);
+    qv_instance_set_gravity(s, g);
+  }
+  for (auto _ : state)
+    for (auto* s : all) qv_instance_step(s);
+  state.counters["r"] = m.info.r;
+  state.counters["frame_ms"] = benchmark::Counter(1e3 * state.iterations(), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.SetLabel("state " + stateHash(all.back(), m.info.r));
+  for (auto* s : all) qv_instance_destroy(s);
+  qv_model_destroy(m.model);
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (__builtin_cpu_supports("avx512f")) benchmark::RegisterBenchmark("PeakFma", PeakFma);
+  for (int i = 1; i < argc; ++i) {
+    const char* path = argv[i];
+    Loaded probe(path);
+    const std::string r = "/r" + std::to_string(probe.info.r);
+    qv_model_destroy(probe.model);
+    benchmark::RegisterBenchmark(("Evaluate/force" + r).c_str(), Evaluate, path, false)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("Evaluate/force+stiffness" + r).c_str(), Evaluate, path, true)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("Step/newmark" + r).c_str(), Step, path)->Unit(benchmark::kMicrosecond);
+    if (probe.info.r == 20)
+      benchmark::RegisterBenchmark(("ManyObjects" + r).c_str(), ManyObjects, path)->Arg(1000)->Unit(benchmark::kMillisecond);
+  }
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

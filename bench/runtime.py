@@ -1,0 +1,64 @@
+#!/usr/bin/python3
+"""The runtime's speed for r = 10, 20, 30, 40, 60 on one core, against the core's FMA peak
+measured in the same run. Bakes a 1 x 0.1 x 0.1 cantilever (40 x 4 x 4 cells) at each r, runs
+bench_runtime on the models, prints a markdown table (the one in bench/README.md).
+
+    /usr/bin/python3 bench/runtime.py --build build/release
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+RANKS = (10, 20, 30, 40, 60)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", default="build/release")
+    ap.add_argument("--repetitions", type=int, default=3)
+    args = ap.parse_args()
+    apps = os.path.join(args.build, "apps")
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_pml="ob1")
+    with tempfile.TemporaryDirectory() as tmp:
+        mesh = os.path.join(tmp, "beam.vtu")
+        subprocess.run([os.path.join(apps, "quiver-mesh"), "beam", "--size", "1,0.1,0.1", "--cells", "40,4,4", "-o", mesh],
+                       check=True)
+        models = []
+        for r in RANKS:
+            name = os.path.join(tmp, f"r{r}")
+            subprocess.run(["mpirun", "-n", "2", os.path.join(apps, "quiver-bake"), mesh, "--fix", "x<min+1e-9",
+                            "--modes", "12", "--rank", str(r), "--quiet", "-o", name], check=True, env=env,
+                           stdin=subprocess.DEVNULL)
+            models.append(name + ".qvr")
+        out = subprocess.run([os.path.join(args.build, "bench", "bench_runtime"), *models, "--benchmark_format=json",
+                              f"--benchmark_repetitions={args.repetitions}", "--benchmark_report_aggregates_only=true"],
+                             check=True, capture_output=True, text=True).stdout
+    rows = {b["name"]: b for b in json.loads(out)["benchmarks"] if b.get("aggregate_name") == "min" or
+            b["name"].endswith("_min")}
+    def get(name):
+        for key, b in rows.items():
+            if key.startswith(name + "_") or key == name:
+                return b
+        return None
+    peak = get("PeakFma")
+    peak_gflops = peak["GFLOPS"] / 1e9 if peak else float("nan")
+    print(f"Peak FMA throughput of this core, measured in the same run: {peak_gflops:.1f} GFLOP/s (AVX-512, double)\n")
+    print("| r | force (us) | force + stiffness (us) | Newmark step (us) | evaluation GFLOP/s | fraction of peak |")
+    print("|---:|---:|---:|---:|---:|---:|")
+    for r in RANKS:
+        f, fk, st = get(f"Evaluate/force/r{r}"), get(f"Evaluate/force+stiffness/r{r}"), get(f"Step/newmark/r{r}")
+        gflops = fk["GFLOPS"] / 1e9
+        print(f"| {r} | {f['real_time']:.2f} | {fk['real_time']:.2f} | {st['real_time']:.2f} | {gflops:.1f} | "
+              f"{gflops / peak_gflops:.0%} |")
+    many = get("ManyObjects/r20/1000")
+    if many:
+        frame = many["real_time"]
+        print(f"\n1000 objects of r = 20 stepped per frame: {frame:.2f} ms per frame on one core "
+              f"({16.667 / frame:.1f}x inside a 60 Hz frame's 16.7 ms).")
+
+
+if __name__ == "__main__":
+    main()
