@@ -36,13 +36,11 @@ def main():
         out = subprocess.run([os.path.join(args.build, "bench", "bench_runtime"), *models, "--benchmark_format=json",
                               f"--benchmark_repetitions={args.repetitions}", "--benchmark_report_aggregates_only=true"],
                              check=True, capture_output=True, text=True).stdout
-    rows = {b["name"]: b for b in json.loads(out)["benchmarks"] if b.get("aggregate_name") == "min" or
-            b["name"].endswith("_min")}
+    # The median of the repetitions: robust to the odd disturbed run on a shared machine.
+    rows = {b["run_name"]: b for b in json.loads(out)["benchmarks"] if b.get("aggregate_name") == "median"}
+
     def get(name):
-        for key, b in rows.items():
-            if key.startswith(name + "_") or key == name:
-                return b
-        return None
+        return rows.get(name)
     peak = get("PeakFma")
     peak_gflops = peak["GFLOPS"] / 1e9 if peak else float("nan")
     print(f"Peak FMA throughput of this core, measured in the same run: {peak_gflops:.1f} GFLOP/s (AVX-512, double)\n")

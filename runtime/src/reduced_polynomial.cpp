@@ -49,12 +49,39 @@ size_t packedCount(size_t pairs) {
 size_t roundUp64(size_t bytes) { return (bytes + 63) & ~size_t(63); }
 
 // y[s] += Q[p][s] x[p] for s > p and y[p] += sum_s Q[p][s] x[s]: one pass over row p of the upper
-// triangle does both halves of the symmetric product (the stored diagonal is halved).
+// triangle does both halves of the symmetric product (the stored diagonal is halved). Rows come
+// four at a time: rows of one 8-aligned group start at the same column and have the same length,
+// so one sweep updates y once for four rows and reads x once.
 template <class C>
 QV_HOT void packedSymmetricProduct(const C* Q, const size_t* rowStart, const size_t* rowOffset, size_t n,
                                    const double* x, double* y) {
   for (size_t s = 0; s < n; ++s) y[s] = 0;
-  for (size_t p = 0; p < n; ++p) {
+  size_t p = 0;
+  for (; p + 4 <= n; p += 4) {
+    const size_t start = rowStart[p];
+    const C* r0 = Q + rowOffset[p] - start;
+    const C* r1 = Q + rowOffset[p + 1] - start;
+    const C* r2 = Q + rowOffset[p + 2] - start;
+    const C* r3 = Q + rowOffset[p + 3] - start;
+    const double x0 = x[p], x1 = x[p + 1], x2 = x[p + 2], x3 = x[p + 3];
+    double d0 = 0, d1 = 0, d2 = 0, d3 = 0;
+#pragma omp simd reduction(+ : d0, d1, d2, d3)
+    for (size_t s = start; s < n; ++s) {
+      const double c0 = static_cast<double>(r0[s]), c1 = static_cast<double>(r1[s]);
+      const double c2 = static_cast<double>(r2[s]), c3 = static_cast<double>(r3[s]);
+      const double xs = x[s];
+      d0 += c0 * xs;
+      d1 += c1 * xs;
+      d2 += c2 * xs;
+      d3 += c3 * xs;
+      y[s] += c0 * x0 + c1 * x1 + c2 * x2 + c3 * x3;
+    }
+    y[p] += d0;
+    y[p + 1] += d1;
+    y[p + 2] += d2;
+    y[p + 3] += d3;
+  }
+  for (; p < n; ++p) {
     const C* row = Q + rowOffset[p] - rowStart[p];
     const double xp = x[p];
     double dot = 0;
