@@ -72,8 +72,8 @@ typedef struct qv_model_info {
 
 /* How a model is held in memory. Fill with qv_model_config_init(). */
 typedef struct qv_model_config {
-  int coefficient_precision; /* 64 (default): the baked coefficients exactly; 32: half the memory and
-                                faster steps, relative error of force and stiffness about 1e-7 */
+  int coefficient_precision; /* 64 (default): the baked coefficients exactly; 32: half the memory,
+                                force and stiffness within about 1e-7 relative (bench/README.md) */
 } qv_model_config;
 QV_API void qv_model_config_init(qv_model_config* config);
 
