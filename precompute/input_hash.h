@@ -9,6 +9,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "formats/model/fnv1a.h"
+
 namespace quiver {
 
 class InputHash {
@@ -35,11 +37,8 @@ public:
   }
 
 private:
-  void addRaw(const void* data, size_t size) {
-    const unsigned char* p = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < size; ++i) state_ = (state_ ^ p[i]) * 0x100000001b3ull;
-  }
-  uint64_t state_ = 0xcbf29ce484222325ull;
+  void addRaw(const void* data, size_t size) { state_ = fnv1a64(data, size, state_); }
+  uint64_t state_ = kFnv1aOffsetBasis;
 };
 
 } // namespace quiver

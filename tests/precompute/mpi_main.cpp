@@ -25,8 +25,12 @@ private:
 
 } // namespace
 
+// OpenBLAS (linked through quiver_precompute): one thread per rank, as the bake runs it.
+extern "C" void openblas_set_num_threads(int);
+
 int main(int argc, char** argv) {
   MPI_Init(&argc, &argv);
+  openblas_set_num_threads(1);
   ::testing::InitGoogleTest(&argc, argv);  // takes its --gtest_* flags; PETSc options stay for PETSc
   if (SlepcInitialize(&argc, &argv, nullptr, nullptr) != 0) {
     std::cerr << "SLEPc/PETSc initialisation failed" << std::endl;
