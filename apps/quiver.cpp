@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/sim_scenario.h"
+#include "apps/support/mesh_options.h"
 #include "formats/model/qvr.h"
 #include "formats/npy.h"
 #include "quiver/quiver.h"
@@ -84,15 +85,41 @@ int main(int argc, char** argv) {
   eval->add_option("--q", qText, "Reduced coordinates: r comma-separated numbers, or FILE.npy")->required();
   CLI::App* sim = app.add_subcommand("sim", "Run a scripted scenario; write a .vtu series (.pvd), a CSV and timings");
   quiver::app::SimOptions simOptions;
+  std::string integrator = "newmark";
   sim->add_option("model", path, "Model file (.qvr)")->required();
   simOptions.addTo(*sim);
+  sim->add_option("--integrator", integrator, "newmark, euler or central")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"newmark", "euler", "central"}));
+  CLI::App* fullSpace = app.add_subcommand("full", "Run the same scenarios on the full-space StVK reference simulator");
+  quiver::app::MeshOptions fullMesh;
+  quiver::app::FixedVertexOptions fullFixed;
+  quiver::app::FullSpaceOptions fullOptions;
+  quiver::app::SimOptions fullSim;
+  fullMesh.addTo(*fullSpace);
+  fullFixed.addTo(*fullSpace);
+  fullSim.addTo(*fullSpace);
+  fullSpace->add_option("--solver", fullOptions.solver,
+                        "Sparse solver: llt, ldlt (Eigen Simplicial), cg (incomplete Cholesky), lu (SparseLU)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"llt", "ldlt", "cg", "lu"}));
+  fullSpace->add_option("--E", fullOptions.material.youngsModulus, "Young's modulus in Pa; overrides the mesh file's");
+  fullSpace->add_option("--nu", fullOptions.material.poissonRatio, "Poisson ratio; overrides the mesh file's");
+  fullSpace->add_option("--density", fullOptions.material.density, "Density in kg/m^3; overrides the mesh file's");
+  fullSpace->add_option("--final-npy", fullOptions.finalNpy, "Save the final displacement (3N, file vertex order) as .npy");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
   try {
-    if (*sim) return quiver::app::runScenario(path, simOptions);
+    if (*fullSpace) {
+      quiver::CheckedMesh mesh = fullMesh.load("quiver");
+      const std::vector<int> fixed = fullFixed.select(mesh);
+      return quiver::app::simulateFullSpace(mesh.mesh, mesh.fileVertex, mesh.loadedVertex.size(), fixed, fullOptions,
+                                            fullSim);
+    }
+    if (*sim) return quiver::app::simulateModel(path, integrator, simOptions);
     ModelHandle model(path);
     qv_model_info mi;
     qv_model_get_info(model.model, &mi);

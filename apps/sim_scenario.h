@@ -1,10 +1,14 @@
 #pragma once
-// `quiver sim`: a scripted scenario on the runtime library, as a game would drive it: pull (or drag
-// and twist) a vertex group for some steps, release, optionally under gravity; write what happens.
+// Scripted scenarios for `quiver sim` (the runtime on a .qvr) and `quiver full` (the full-space
+// reference on a mesh): pull a vertex group with a force, or drag and twist it with penalty springs,
+// for some steps, release, optionally under gravity; write what happens. One script drives both,
+// so their outputs compare like for like.
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
+
+#include "common/tet_mesh.h"
 
 namespace quiver::app {
 
@@ -17,18 +21,55 @@ struct SimOptions {
   double twist = 0;                     // degrees about the x axis through the group's centre (drag mode)
   double stiffness = 1e4;               // N/m per vertex, drag mode's penalty springs
   bool gravity = false;                 // add g = 9.81 m/s^2 along -z
-  std::string integrator = "newmark";   // newmark | euler | central
-  double timeStep = 0;                  // s; 0: the model's
-  int newton = 1;                       // Newton iterations per step
-  double alpha = -1, beta = -1;         // Rayleigh damping; negative: the model's
-  std::string output;                   // NAME: NAME.pvd, NAME_NNNN.vtu, NAME.csv; "" for none
+  double timeStep = 0;                  // s; 0: the simulator's default
+  int newton = 1;                       // Newton iterations per step (runtime), or the most (full space)
+  double alpha = -1, beta = -1;         // Rayleigh damping; negative: the default
+  std::string output;                   // NAME: NAME.pvd, NAME_NNNNN.vtu, NAME.csv; "" for none
   int every = 1;                        // write every k-th step
   bool json = false;                    // print one JSON summary instead of text
 
   void addTo(CLI::App& app);
 };
 
-// Returns the process exit code; throws std::runtime_error on bad input.
-int runScenario(const std::string& modelPath, const SimOptions& options);
+// What a scenario drives: the runtime's instance or the full-space simulator.
+class ScenarioTarget {
+public:
+  virtual ~ScenarioTarget() = default;
+  virtual void addVertexForce(int vertex, const double force[3]) = 0;
+  virtual void setGravity(const double acceleration[3]) = 0;
+  virtual void setSprings(const std::vector<int>& vertices, const std::vector<double>& targets, double stiffness) = 0;
+  virtual void clearSprings() = 0;
+  // Advances one step; returns a status for the CSV (0 ok) and counts Newton iterations.
+  virtual int step(int& newtonIterations) = 0;
+  virtual void displacement(std::vector<double>& u) const = 0;  // 3 per vertex
+  virtual void energies(double& kinetic, double& elastic) const = 0;
+  virtual double timeStep() const = 0;
+};
+
+struct ScenarioResult {
+  std::vector<double> stepMicros;
+  long newtonIterations = 0;
+  int failedSteps = 0;  // resets (runtime) — the scenario goes on
+};
+
+// Runs the scenario on `target` over `mesh` (rest shape, and tets for the .vtu frames).
+ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const SimOptions& options);
+
+// Median and 99th percentile of step times, in microseconds.
+double percentile(std::vector<double> values, double p);
+
+// `quiver sim MODEL.qvr`: returns the exit code.
+int simulateModel(const std::string& modelPath, const std::string& integrator, const SimOptions& options);
+
+struct FullSpaceOptions {
+  std::string solver = "ldlt";          // llt | ldlt | cg | lu
+  MaterialOverride material;            // over the mesh file's materials
+  std::string finalNpy;                 // save the final displacement (3N, the file's vertex order)
+};
+
+// `quiver full MESH`: the same scenario on the full-space reference; returns the exit code.
+// `fileVertex` maps loaded vertices to the mesh file's order, `fileVertexCount` is N.
+int simulateFullSpace(const TetMesh& mesh, const std::vector<int>& fileVertex, size_t fileVertexCount,
+                      const std::vector<int>& fixed, const FullSpaceOptions& full, const SimOptions& options);
 
 } // namespace quiver::app
