@@ -86,11 +86,13 @@ int main(int argc, char** argv) {
   CLI::App* sim = app.add_subcommand("sim", "Run a scripted scenario; write a .vtu series (.pvd), a CSV and timings");
   quiver::app::SimOptions simOptions;
   std::string integrator = "newmark";
+  bool linear = false;
   sim->add_option("model", path, "Model file (.qvr)")->required();
   simOptions.addTo(*sim);
   sim->add_option("--integrator", integrator, "newmark, euler or central")
       ->capture_default_str()
       ->check(CLI::IsMember({"newmark", "euler", "central"}));
+  sim->add_flag("--linear", linear, "Linear modal dynamics (R = K(0) q) in the same subspace, for comparison");
   CLI::App* fullSpace = app.add_subcommand("full", "Run the same scenarios on the full-space StVK reference simulator");
   quiver::app::MeshOptions fullMesh;
   quiver::app::FixedVertexOptions fullFixed;
@@ -119,7 +121,7 @@ int main(int argc, char** argv) {
       return quiver::app::simulateFullSpace(mesh.mesh, mesh.fileVertex, mesh.loadedVertex.size(), fixed, fullOptions,
                                             fullSim);
     }
-    if (*sim) return quiver::app::simulateModel(path, integrator, simOptions);
+    if (*sim) return quiver::app::simulateModel(path, integrator, linear, simOptions);
     ModelHandle model(path);
     qv_model_info mi;
     qv_model_get_info(model.model, &mi);

@@ -14,7 +14,7 @@ namespace {
 
 class RuntimeTarget : public ScenarioTarget {
 public:
-  RuntimeTarget(const std::string& path, const std::string& integrator, const SimOptions& o) {
+  RuntimeTarget(const std::string& path, const std::string& integrator, bool linear, const SimOptions& o) {
     char message[1024] = "";
     if (qv_model_load_file(path.c_str(), nullptr, nullptr, &model_, message, sizeof message) != QV_OK)
       throw std::runtime_error(message);
@@ -25,6 +25,7 @@ public:
                                                    : QV_INTEGRATOR_IMPLICIT_NEWMARK;
     if (o.timeStep > 0) config_.time_step = o.timeStep;
     config_.newton_iterations = o.newton;
+    config_.linear = linear ? 1 : 0;
     if (o.alpha >= 0) config_.rayleigh_alpha = o.alpha;
     if (o.beta >= 0) config_.rayleigh_beta = o.beta;
     if (qv_instance_create(model_, &config_, nullptr, &instance_) != QV_OK)
@@ -87,8 +88,8 @@ TetMesh modelMesh(const std::string& path) {
 
 } // namespace
 
-int simulateModel(const std::string& path, const std::string& integrator, const SimOptions& o) {
-  RuntimeTarget target(path, integrator, o);
+int simulateModel(const std::string& path, const std::string& integrator, bool linear, const SimOptions& o) {
+  RuntimeTarget target(path, integrator, linear, o);
   const ScenarioResult result = runScenario(target, modelMesh(path), o);
   double total = 0;
   for (double us : result.stepMicros) total += us;
@@ -99,6 +100,7 @@ int simulateModel(const std::string& path, const std::string& integrator, const 
     j["steps"] = o.steps;
     j["time_step_s"] = target.timeStep();
     j["integrator"] = integrator;
+    j["elasticity"] = linear ? "linear" : "stvk";
     j["step_us_median"] = median;
     j["step_us_p99"] = p99;
     j["steps_per_second"] = 1e6 * o.steps / total;

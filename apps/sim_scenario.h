@@ -59,7 +59,8 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
 double percentile(std::vector<double> values, double p);
 
 // `quiver sim MODEL.qvr`: returns the exit code.
-int simulateModel(const std::string& modelPath, const std::string& integrator, const SimOptions& options);
+// `linear`: linear modal dynamics in the same subspace (R = K(0) q) instead of St.Venant-Kirchhoff.
+int simulateModel(const std::string& modelPath, const std::string& integrator, bool linear, const SimOptions& options);
 
 struct FullSpaceOptions {
   std::string solver = "ldlt";          // llt | ldlt | cg | lu

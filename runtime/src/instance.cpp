@@ -51,6 +51,7 @@ struct qv_instance {
   int* slotActive;
   // scratch
   double *force, *stiffness, *system, *rhs, *trialQ, *trialV, *next, *polyScratch;
+  double* restStiffness;   // K(0), for linear modal dynamics
   int* pivot;
 
   template <class Carve>
@@ -75,11 +76,22 @@ struct qv_instance {
     next = c.template take<double>(r);
     pivot = c.template take<int>(r);
     polyScratch = c.template take<double>(quiver::rt::ReducedPolynomial::scratchSize(r));
+    restStiffness = c.template take<double>(rr);
   }
 
-  // Elastic force and stiffness at `at`, plus the penalty constraints: R + Kc q - bc, K + Kc.
+  // Elastic force and stiffness at `at` (StVK, or K(0) q when linear), plus the penalty
+  // constraints: R + Kc q - bc, K + Kc.
   void evaluate(const double* at, double* energy) {
-    model->polynomial.evaluate(at, energy, force, stiffness, polyScratch);
+    if (config.linear) {
+      std::memcpy(stiffness, restStiffness, sizeof(double) * r * r);
+      for (int i = 0; i < r; ++i) {
+        double s = 0;
+        for (int j = 0; j < r; ++j) s += restStiffness[i * r + j] * at[j];
+        force[i] = s;
+      }
+    } else {
+      model->polynomial.evaluate(at, energy, force, stiffness, polyScratch);
+    }
     for (int i = 0; i < r; ++i) {
       double s = -constraintB[i];
       for (int j = 0; j < r; ++j) s += constraintK[i * r + j] * at[j];
@@ -262,7 +274,8 @@ qv_instance* construct(const qv_model* model, const qv_instance_config* config, 
     rowNorm = std::fmax(rowNorm, sum);
   }
   s->maxQ = rowNorm > 0 ? config->max_displacement / rowNorm : config->max_displacement;
-  const double lambdaMax = largestRestEigenvalue(s);
+  const double lambdaMax = largestRestEigenvalue(s);  // also leaves K(0) in s->stiffness
+  std::memcpy(s->restStiffness, s->stiffness, sizeof(double) * s->r * s->r);
   s->stableStep = lambdaMax > 0 ? 2.0 / std::sqrt(lambdaMax) : INFINITY;
   std::memset(s->stepForce, 0, sizeof(double) * s->r);
   std::memset(s->gravityForce, 0, sizeof(double) * s->r);
@@ -291,6 +304,7 @@ void qv_instance_config_init(qv_instance_config* config, const qv_model* model) 
     diagonal = std::sqrt(d2);
   }
   config->max_displacement = 100.0 * diagonal;
+  config->linear = 0;
 }
 
 size_t qv_instance_memory_requirements(const qv_model* model, const qv_instance_config* config) {
@@ -423,7 +437,14 @@ void qv_instance_energies(const qv_instance* s, double* kinetic, double* elastic
   double k = 0;
   for (int i = 0; i < s->r; ++i) k += 0.5 * s->v[i] * s->v[i];
   if (kinetic) *kinetic = k;
-  if (elastic) s->model->polynomial.evaluate(s->q, elastic, nullptr, nullptr, s->polyScratch);
+  if (elastic && s->config.linear) {
+    double e = 0;
+    for (int i = 0; i < s->r; ++i)
+      for (int j = 0; j < s->r; ++j) e += 0.5 * s->q[i] * s->restStiffness[i * s->r + j] * s->q[j];
+    *elastic = e;
+  } else if (elastic) {
+    s->model->polynomial.evaluate(s->q, elastic, nullptr, nullptr, s->polyScratch);
+  }
 }
 
 double qv_instance_stable_time_step(const qv_instance* s) { return s ? s->stableStep : 0; }

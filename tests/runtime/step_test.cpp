@@ -217,3 +217,39 @@ TEST(Step, DragSpringPullsAVertexToItsTarget) {
   ASSERT_EQ(qv_instance_positions_of(inst.s, &tip, 1, p), QV_OK);
   EXPECT_NEAR(p[2], X.z(), 1e-4);  // released: back to rest
 }
+
+// Linear modal dynamics (config.linear): the same Newmark scheme on q'' + K(0) q = f, with K(0)
+// taken from the full-space FEM; and, unlike StVK, a stretch that grows with the load squared
+// is absent: doubling the load doubles the response exactly.
+TEST(Step, LinearModalDynamicsIsExactlyLinear) {
+  test::BakedModel m;
+  ASSERT_NE(m.model, nullptr);
+  const int r = m.info.r, tip = m.tipVertex();
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  config.linear = 1;
+  config.rayleigh_alpha = config.rayleigh_beta = 0;
+  const double h = config.time_step;
+  Eigen::VectorXd zero = Eigen::VectorXd::Zero(r), R;
+  Eigen::MatrixXd K0;
+  m.exact(zero, R, K0);
+  std::vector<Eigen::VectorXd> finals;
+  for (double scale : {1.0, 2.0}) {
+    Instance inst(m.model, config);
+    const double pull[3] = {0, 0, -20.0 * scale};  // large enough that StVK would not be linear
+    const Eigen::VectorXd f = m.U.middleRows(3 * tip, 3).transpose() * Eigen::Map<const Eigen::Vector3d>(pull);
+    Eigen::VectorXd q = zero, v = zero, a = zero;
+    const Eigen::MatrixXd A = Eigen::MatrixXd::Identity(r, r) + 0.25 * h * h * K0;
+    for (int step = 0; step < 100; ++step) {
+      qv_instance_add_vertex_force(inst.s, tip, pull);
+      ASSERT_NE(qv_instance_step(inst.s), QV_STEP_RESET);
+      const Eigen::VectorXd next = A.ldlt().solve(f - K0 * (q + h * v + 0.25 * h * h * a));
+      q += h * v + 0.25 * h * h * (a + next);
+      v += 0.5 * h * (a + next);
+      a = next;
+    }
+    EXPECT_LT((state(inst.s, r) - q).norm(), 1e-9 * q.norm());
+    finals.push_back(state(inst.s, r));
+  }
+  EXPECT_LT((finals[1] - 2 * finals[0]).norm(), 1e-12 * finals[1].norm());
+}

@@ -132,6 +132,8 @@ typedef struct qv_instance_config {
   double rayleigh_beta;      /* s, >= 0; default: the model's */
   int max_constraints;       /* penalty constraint slots (drag springs, pinned groups), 0..64; default 4 */
   double max_displacement;   /* m; a step that moves a vertex farther resets the instance; default 100 x the model's diagonal */
+  int linear;                /* non-zero: linear modal dynamics, R(q) = K(0) q (small-strain elasticity in the same
+                                subspace, for comparison); default 0: St.Venant-Kirchhoff */
 } qv_instance_config;
 
 /* Defaults for `model` (pass NULL for model-independent defaults). */
