@@ -129,28 +129,34 @@ void FullSpaceSimulator::solve(const SparseMatrix& A, const Eigen::VectorXd& b, 
 int FullSpaceSimulator::step() {
   const double h = settings_.timeStep, beta = 0.25, gamma = 0.5;
   const double alpha = settings_.rayleighAlpha, betaK = settings_.rayleighBeta;
-  Eigen::VectorXd next = a_, q, vel, residual, delta;
   const Eigen::VectorXd external = stepForce_ + gravityForce_;
-  for (int it = 1; it <= settings_.maxNewtonIterations; ++it) {
-    q = u_ + h * v_ + h * h * ((0.5 - beta) * a_ + beta * next);
-    vel = v_ + h * ((1 - gamma) * a_ + gamma * next);
+  Eigen::VectorXd next = a_, q, vel, residual, delta, trialResidual;
+  // The Newmark residual at acceleration `acc`: M acc + C(q) vel + R(q) - f, with q and vel from acc.
+  // Leaves q, vel and the elastic tangent at q (when asked) in the members used below.
+  auto residualAt = [&](const Eigen::VectorXd& acc, Eigen::VectorXd& out, bool withTangent) {
+    q = u_ + h * v_ + h * h * ((0.5 - beta) * a_ + beta * acc);
+    vel = v_ + h * ((1 - gamma) * a_ + gamma * acc);
     model_.internalForce(q, force_);
-    model_.tangentStiffness(q, tangent_);
+    if (withTangent) model_.tangentStiffness(q, tangent_);
     for (size_t k = 0; k < springVertices_.size(); ++k) {
       const int v = springVertices_[k];
       force_.segment<3>(3 * v) += springStiffness_ * (rest_[v] + q.segment<3>(3 * v) - springTargets_[k]);
     }
-    residual = mass_ * next + alpha * (mass_ * vel) + betaK * (tangent_ * vel) + force_ - external;
+    out = mass_ * acc + alpha * (mass_ * vel) + betaK * (tangent_ * vel) + force_ - external;
     for (int d = 0; d < dofCount(); ++d)
-      if (fixedDof_[d]) residual[d] = 0;
-    const double scale = (mass_ * next).norm() + external.norm() + force_.norm() + 1e-300;
-    if (residual.norm() <= settings_.newtonTolerance * scale && it > 1) {
+      if (fixedDof_[d]) out[d] = 0;
+    return (mass_ * acc).norm() + external.norm() + force_.norm() + 1e-300;
+  };
+  for (int it = 0; it <= settings_.maxNewtonIterations; ++it) {
+    const double scale = residualAt(next, residual, true);
+    if (residual.norm() <= settings_.newtonTolerance * scale && it > 0) {
       u_ = q;
       v_ = vel;
       a_ = next;
       stepForce_.setZero();
-      return it - 1;
+      return it;
     }
+    if (it == settings_.maxNewtonIterations) break;
     // J = (1 + gamma h alpha) M + (gamma h beta_K + beta h^2) K, springs on the diagonal.
     const double cm = 1 + gamma * h * alpha, ck = gamma * h * betaK + beta * h * h;
     double* A = system_.valuePtr();
@@ -162,7 +168,14 @@ int FullSpaceSimulator::step() {
     Eigen::VectorXd rhs = -residual;
     applyConstraints(system_, rhs);
     solve(system_, rhs, delta);
-    next += delta;
+    // Backtracking: after a sudden release the last acceleration is a poor start, and a full
+    // Newton step on StVK can overshoot; halve it until the residual drops.
+    double step = 1;
+    for (int halving = 0; halving < 8; ++halving, step *= 0.5) {
+      residualAt(next + step * delta, trialResidual, false);
+      if (trialResidual.norm() < residual.norm()) break;
+    }
+    next += step * delta;
   }
   throw std::runtime_error("full-space simulator: Newton did not converge in " +
                            std::to_string(settings_.maxNewtonIterations) + " iterations");
