@@ -86,13 +86,16 @@ int main(int argc, char** argv) {
   CLI::App* sim = app.add_subcommand("sim", "Run a scripted scenario; write a .vtu series (.pvd), a CSV and timings");
   quiver::app::SimOptions simOptions;
   std::string integrator = "newmark";
-  bool linear = false;
+  std::string elasticity = "stvk";
   sim->add_option("model", path, "Model file (.qvr)")->required();
   simOptions.addTo(*sim);
   sim->add_option("--integrator", integrator, "newmark, euler or central")
       ->capture_default_str()
       ->check(CLI::IsMember({"newmark", "euler", "central"}));
-  sim->add_flag("--linear", linear, "Linear modal dynamics (R = K(0) q) in the same subspace, for comparison");
+  sim->add_option("--elasticity", elasticity,
+                  "stvk (the reduced model), linear (R = K(0) q in the same subspace) or warping (linear + modal warping)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"stvk", "linear", "warping"}));
   CLI::App* fullSpace = app.add_subcommand("full", "Run the same scenarios on the full-space StVK reference simulator");
   quiver::app::MeshOptions fullMesh;
   quiver::app::FixedVertexOptions fullFixed;
@@ -121,7 +124,7 @@ int main(int argc, char** argv) {
       return quiver::app::simulateFullSpace(mesh.mesh, mesh.fileVertex, mesh.loadedVertex.size(), fixed, fullOptions,
                                             fullSim);
     }
-    if (*sim) return quiver::app::simulateModel(path, integrator, linear, simOptions);
+    if (*sim) return quiver::app::simulateModel(path, integrator, elasticity, simOptions);
     ModelHandle model(path);
     qv_model_info mi;
     qv_model_get_info(model.model, &mi);

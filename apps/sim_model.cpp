@@ -14,7 +14,8 @@ namespace {
 
 class RuntimeTarget : public ScenarioTarget {
 public:
-  RuntimeTarget(const std::string& path, const std::string& integrator, bool linear, const SimOptions& o) {
+  RuntimeTarget(const std::string& path, const std::string& integrator, const std::string& elasticity,
+                const SimOptions& o) {
     char message[1024] = "";
     if (qv_model_load_file(path.c_str(), nullptr, nullptr, &model_, message, sizeof message) != QV_OK)
       throw std::runtime_error(message);
@@ -25,11 +26,14 @@ public:
                                                    : QV_INTEGRATOR_IMPLICIT_NEWMARK;
     if (o.timeStep > 0) config_.time_step = o.timeStep;
     config_.newton_iterations = o.newton;
-    config_.linear = linear ? 1 : 0;
+    config_.linear = elasticity == "linear";
+    config_.warping = elasticity == "warping";
     if (o.alpha >= 0) config_.rayleigh_alpha = o.alpha;
     if (o.beta >= 0) config_.rayleigh_beta = o.beta;
     if (qv_instance_create(model_, &config_, nullptr, &instance_) != QV_OK)
-      throw std::runtime_error("invalid simulation settings (time step, Newton iterations, damping)");
+      throw std::runtime_error(config_.warping && !info_.has_modal_rotations
+                                   ? path + " has no modal rotations (bake it again for modal warping)"
+                                   : "invalid simulation settings (time step, Newton iterations, damping)");
     if (config_.integrator == QV_INTEGRATOR_CENTRAL_DIFFERENCES && config_.time_step > qv_instance_stable_time_step(instance_))
       std::cerr << "quiver: warning: --dt " << config_.time_step << " s is above central differences' stable step "
                 << qv_instance_stable_time_step(instance_) << " s\n";
@@ -88,8 +92,9 @@ TetMesh modelMesh(const std::string& path) {
 
 } // namespace
 
-int simulateModel(const std::string& path, const std::string& integrator, bool linear, const SimOptions& o) {
-  RuntimeTarget target(path, integrator, linear, o);
+int simulateModel(const std::string& path, const std::string& integrator, const std::string& elasticity,
+                  const SimOptions& o) {
+  RuntimeTarget target(path, integrator, elasticity, o);
   const ScenarioResult result = runScenario(target, modelMesh(path), o);
   double total = 0;
   for (double us : result.stepMicros) total += us;
@@ -100,7 +105,7 @@ int simulateModel(const std::string& path, const std::string& integrator, bool l
     j["steps"] = o.steps;
     j["time_step_s"] = target.timeStep();
     j["integrator"] = integrator;
-    j["elasticity"] = linear ? "linear" : "stvk";
+    j["elasticity"] = elasticity;
     j["step_us_median"] = median;
     j["step_us_p99"] = p99;
     j["steps_per_second"] = 1e6 * o.steps / total;

@@ -59,8 +59,10 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
 double percentile(std::vector<double> values, double p);
 
 // `quiver sim MODEL.qvr`: returns the exit code.
-// `linear`: linear modal dynamics in the same subspace (R = K(0) q) instead of St.Venant-Kirchhoff.
-int simulateModel(const std::string& modelPath, const std::string& integrator, bool linear, const SimOptions& options);
+// `elasticity`: "stvk" (the model's), "linear" (R = K(0) q in the same subspace) or "warping"
+// (linear, with modal warping).
+int simulateModel(const std::string& modelPath, const std::string& integrator, const std::string& elasticity,
+                  const SimOptions& options);
 
 struct FullSpaceOptions {
   std::string solver = "ldlt";          // llt | ldlt | cg | lu

@@ -38,7 +38,8 @@ enum SectionType : uint32_t {
   kVertexMap = 6,
   kGravityProjection = 7,
   kEigenvalues = 8,
-  kTets = 9,  // the only section a file may omit
+  kTets = 9,             // optional: readers need not have it
+  kModalRotations = 10,  // optional (written with the optional flag, so 1.0 readers skip it)
 };
 
 } // namespace qvr
@@ -127,6 +128,8 @@ struct ModelView {
   const double* gravity = nullptr;          // 3 x r: row a is U^T M e_a (e_a: unit acceleration along axis a)
   const double* eigenvalues = nullptr;      // eigenvalueCount values
   const uint32_t* tets = nullptr;           // 4 tetCount vertex indices; null when the file has no TETS
+  const double* rotations = nullptr;        // 3n x r, row-major: vertex v's small rotation w_v = Psi_v q (modal
+                                            // warping, Choi & Ko 2005); null when the file has no MODAL_ROTATIONS
 };
 
 // Validates the .qvr file held in `data` (the whole file, `size` bytes, 8-byte aligned as malloc,

@@ -22,11 +22,12 @@ namespace {
 
 using namespace qvr;
 
-constexpr uint32_t kLastKnownType = kTets;
+constexpr uint32_t kLastKnownType = kModalRotations;
 
 const char* knownName(uint32_t type) {
   static const char* const kNames[] = {"", "MODEL_INFO", "ENERGY_COEFFICIENTS", "BASIS", "REST_POSITIONS",
-                                       "SURFACE_TRIANGLES", "VERTEX_MAP", "GRAVITY_PROJECTION", "EIGENVALUES", "TETS"};
+                                       "SURFACE_TRIANGLES", "VERTEX_MAP", "GRAVITY_PROJECTION", "EIGENVALUES", "TETS",
+                                       "MODAL_ROTATIONS"};
   return type >= 1 && type <= kLastKnownType ? kNames[type] : nullptr;
 }
 
@@ -181,7 +182,8 @@ private:
       if (!checkSection(s)) return false;
     }
     for (uint32_t type = kModelInfo; type <= kLastKnownType; ++type)
-      if (!byType_[type] && type != kTets) return fail("missing required section " + sectionName(type));
+      if (!byType_[type] && type != kTets && type != kModalRotations)
+        return fail("missing required section " + sectionName(type));
     return true;
   }
 
@@ -359,7 +361,11 @@ private:
         floats(kGravityProjection, 3 * r, "3 x " + rText, view.gravity) &&
         floats(kEigenvalues, info.eigenvalueCount, std::to_string(info.eigenvalueCount) + " eigenvalues",
                view.eigenvalues);
-    if (!ok || !byType_[kTets]) return ok;
+    if (!ok) return false;
+    if (byType_[kModalRotations] &&
+        !floats(kModalRotations, 3 * n * r, "3 x " + vertices + " x " + rText, view.rotations))
+      return false;
+    if (!byType_[kTets]) return true;
     return indices(*byType_[kTets], info.tetCount, 4, "4 x " + std::to_string(info.tetCount) + " tets",
                    info.vertexCount, "vertexCount", view.tets);
   }

@@ -28,11 +28,12 @@ struct Piece {
   SectionType type;
   const void* data;
   size_t size;
+  uint32_t flags = 0;
 };
 
 template <class T>
-Piece piece(SectionType type, const std::vector<T>& values) {
-  return {type, values.data(), values.size() * sizeof(T)};
+Piece piece(SectionType type, const std::vector<T>& values, uint32_t flags = 0) {
+  return {type, values.data(), values.size() * sizeof(T), flags};
 }
 
 size_t alignUp(size_t at) { return (at + kSectionAlignment - 1) / kSectionAlignment * kSectionAlignment; }
@@ -61,6 +62,7 @@ std::string formatModel(const ModelContents& c) {
                                piece(kGravityProjection, c.gravity),
                                piece(kEigenvalues, c.eigenvalues)};
   if (!c.tets.empty()) pieces.push_back(piece(kTets, c.tets));
+  if (!c.rotations.empty()) pieces.push_back(piece(kModalRotations, c.rotations, kOptionalSection));
 
   const size_t tableSize = pieces.size() * kSectionEntrySize;
   std::vector<size_t> offsets;
@@ -76,6 +78,7 @@ std::string formatModel(const ModelContents& c) {
     if (p.size > 0) std::memcpy(out + offsets[i], p.data, p.size);
     unsigned char* entry = out + kHeaderSize + i * kSectionEntrySize;
     storeLE(entry + kTypeAt, p.type, 4);
+    storeLE(entry + kFlagsAt, p.flags, 4);
     storeLE(entry + kOffsetAt, offsets[i], 8);
     storeLE(entry + kSizeAt, p.size, 8);
     storeLE(entry + kChecksumAt, fnv1a64(p.data, p.size), 8);
@@ -120,6 +123,7 @@ ModelContents copyModel(const ModelView& view) {
   c.gravity.assign(view.gravity, view.gravity + 3 * r);
   c.eigenvalues.assign(view.eigenvalues, view.eigenvalues + info.eigenvalueCount);
   if (view.tets) c.tets.assign(view.tets, view.tets + size_t{4} * info.tetCount);
+  if (view.rotations) c.rotations.assign(view.rotations, view.rotations + size_t{3} * info.vertexCount * info.r);
   return c;
 }
 

@@ -20,6 +20,7 @@ struct ModelContents {
   std::vector<double> gravity;        // 3 x r, row a = U^T M e_a
   std::vector<double> eigenvalues;    // info.eigenvalueCount
   std::vector<uint32_t> tets;         // 4 x info.tetCount, or empty to leave the TETS section out
+  std::vector<double> rotations;      // 3n x r modal rotations (see ModelView), or empty to leave them out
 };
 
 // The bytes of a version 1.0 .qvr file: the sections in type order, each at the next multiple of

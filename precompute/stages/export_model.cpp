@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "common/modal_rotation.h"
 #include "common/surface.h"
 
 namespace quiver {
@@ -67,6 +68,11 @@ ModelContents makeModelContents(const CheckedMesh& mesh, const std::vector<Mater
   c.eigenvalues = eigenvalues;
   for (const Tet& t : m.tets)
     for (int v : t) c.tets.push_back(static_cast<uint32_t>(v));
+  // Modal rotations for modal warping: each basis vector's vertex rotations (1/2 curl).
+  const Eigen::MatrixXd psi = vertexRotations(m, basis);
+  c.rotations.resize(psi.size());
+  for (Eigen::Index i = 0; i < psi.rows(); ++i)
+    for (int j = 0; j < r; ++j) c.rotations[i * r + j] = psi(i, j);
   return c;
 }
 

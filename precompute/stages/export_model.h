@@ -1,7 +1,8 @@
 #pragma once
 // Stage "export": the runtime model NAME.qvr (formats/model/QVR.md) from the bake's results:
 // energy polynomial, basis rows, rest positions, surface triangles, the vertex map back to the
-// mesh file, the gravity projection U^T M e_a, eigenvalues, material and default damping.
+// mesh file, the gravity projection U^T M e_a, eigenvalues, material, default damping, and the
+// modal rotations (1/2 curl of each basis vector at the vertices) for modal warping.
 #include <vector>
 
 #include <Eigen/Core>

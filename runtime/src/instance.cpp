@@ -4,6 +4,7 @@
 #include <new>
 
 #include "dense_solve.h"
+#include "modal_warping.h"
 #include "quiver/quiver.h"
 
 namespace {
@@ -30,6 +31,21 @@ private:
 double basisEntry(const qv_model* m, size_t row, size_t j) {
   const size_t r = static_cast<size_t>(m->info.r);
   return m->basis32 ? static_cast<double>(m->basis32[row * r + j]) : m->basis64[row * r + j];
+}
+
+// Vertex v's linear displacement U_v q and, with modal rotations, its rotation w_v = Psi_v q.
+void vertexLinear(const qv_model* m, int v, const double* q, double d[3], double w[3]) {
+  const size_t r = static_cast<size_t>(m->info.r);
+  for (int c = 0; c < 3; ++c) {
+    const size_t row = 3 * static_cast<size_t>(v) + c;
+    double du = 0, dw = 0;
+    for (size_t j = 0; j < r; ++j) {
+      du += basisEntry(m, row, j) * q[j];
+      if (w) dw += m->rotations[row * r + j] * q[j];
+    }
+    d[c] = du;
+    if (w) w[c] = dw;
+  }
 }
 
 } // namespace
@@ -82,7 +98,7 @@ struct qv_instance {
   // Elastic force and stiffness at `at` (StVK, or K(0) q when linear), plus the penalty
   // constraints: R + Kc q - bc, K + Kc.
   void evaluate(const double* at, double* energy) {
-    if (config.linear) {
+    if (config.linear || config.warping) {
       std::memcpy(stiffness, restStiffness, sizeof(double) * r * r);
       for (int i = 0; i < r; ++i) {
         double s = 0;
@@ -215,8 +231,19 @@ struct qv_instance {
 
 namespace {
 
+// Vertex v's displacement: U_v q, warped by its rotation under modal warping.
+void vertexDisplacement(const qv_instance* s, int v, double u[3]) {
+  if (!s->config.warping) {
+    vertexLinear(s->model, v, s->q, u, nullptr);
+    return;
+  }
+  double d[3], w[3];
+  vertexLinear(s->model, v, s->q, d, w);
+  quiver::rt::warpDisplacement(w, d, u);
+}
+
 bool validConfig(const qv_model* model, const qv_instance_config* c) {
-  return model && c && c->time_step > 0 && std::isfinite(c->time_step) && c->newton_iterations >= 1 &&
+  return model && c && (!c->warping || model->rotations) && c->time_step > 0 && std::isfinite(c->time_step) && c->newton_iterations >= 1 &&
          c->rayleigh_alpha >= 0 && c->rayleigh_beta >= 0 && c->max_constraints >= 0 && c->max_constraints <= 64 &&
          c->max_displacement > 0 &&
          (c->integrator == QV_INTEGRATOR_IMPLICIT_NEWMARK || c->integrator == QV_INTEGRATOR_BACKWARD_EULER ||
@@ -305,6 +332,7 @@ void qv_instance_config_init(qv_instance_config* config, const qv_model* model) 
   }
   config->max_displacement = 100.0 * diagonal;
   config->linear = 0;
+  config->warping = 0;
 }
 
 size_t qv_instance_memory_requirements(const qv_model* model, const qv_instance_config* config) {
@@ -363,8 +391,21 @@ qv_step_status qv_instance_step(qv_instance* s) {
 
 qv_result qv_instance_add_vertex_force(qv_instance* s, int vertex, const double force[3]) {
   if (!s || !force || vertex < 0 || vertex >= s->model->info.vertex_count) return QV_ERROR_INVALID_ARGUMENT;
+  double local[3] = {force[0], force[1], force[2]};
+  if (s->config.warping) {
+    // Into the vertex's rotated frame: R(w)^T f, the rotation by -w (Rodrigues).
+    double d[3], w[3], axis[3], c1[3], c2[3];
+    vertexLinear(s->model, vertex, s->q, d, w);
+    const double angle = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    if (angle > 0) {
+      for (int c = 0; c < 3; ++c) axis[c] = -w[c] / angle;
+      quiver::rt::cross3(axis, force, c1);
+      quiver::rt::cross3(axis, c1, c2);
+      for (int c = 0; c < 3; ++c) local[c] = force[c] + std::sin(angle) * c1[c] + (1 - std::cos(angle)) * c2[c];
+    }
+  }
   for (int j = 0; j < s->r; ++j)
-    for (int c = 0; c < 3; ++c) s->stepForce[j] += basisEntry(s->model, 3 * static_cast<size_t>(vertex) + c, j) * force[c];
+    for (int c = 0; c < 3; ++c) s->stepForce[j] += basisEntry(s->model, 3 * static_cast<size_t>(vertex) + c, j) * local[c];
   return QV_OK;
 }
 
@@ -437,7 +478,7 @@ void qv_instance_energies(const qv_instance* s, double* kinetic, double* elastic
   double k = 0;
   for (int i = 0; i < s->r; ++i) k += 0.5 * s->v[i] * s->v[i];
   if (kinetic) *kinetic = k;
-  if (elastic && s->config.linear) {
+  if (elastic && (s->config.linear || s->config.warping)) {
     double e = 0;
     for (int i = 0; i < s->r; ++i)
       for (int j = 0; j < s->r; ++j) e += 0.5 * s->q[i] * s->restStiffness[i * s->r + j] * s->q[j];
@@ -451,21 +492,26 @@ double qv_instance_stable_time_step(const qv_instance* s) { return s ? s->stable
 
 void qv_instance_positions(const qv_instance* s, float* positions) {
   if (!s || !positions) return;
-  qv_model_displacements(s->model, s->q, positions);
-  for (size_t i = 0; i < 3 * static_cast<size_t>(s->model->info.vertex_count); ++i)
-    positions[i] = static_cast<float>(s->model->rest[i] + positions[i]);
+  if (!s->config.warping) {
+    qv_model_displacements(s->model, s->q, positions);
+    for (size_t i = 0; i < 3 * static_cast<size_t>(s->model->info.vertex_count); ++i)
+      positions[i] = static_cast<float>(s->model->rest[i] + positions[i]);
+    return;
+  }
+  for (int v = 0; v < s->model->info.vertex_count; ++v) {
+    double u[3];
+    vertexDisplacement(s, v, u);
+    for (int c = 0; c < 3; ++c) positions[3 * v + c] = static_cast<float>(s->model->rest[3 * v + c] + u[c]);
+  }
 }
 
 qv_result qv_instance_positions_of(const qv_instance* s, const int* vertices, int count, float* positions) {
   if (!s || !vertices || !positions || count < 0) return QV_ERROR_INVALID_ARGUMENT;
   for (int k = 0; k < count; ++k) {
     if (vertices[k] < 0 || vertices[k] >= s->model->info.vertex_count) return QV_ERROR_INVALID_ARGUMENT;
-    for (int c = 0; c < 3; ++c) {
-      const size_t row = 3 * static_cast<size_t>(vertices[k]) + c;
-      double x = s->model->rest[row];
-      for (int j = 0; j < s->r; ++j) x += basisEntry(s->model, row, j) * s->q[j];
-      positions[3 * k + c] = static_cast<float>(x);
-    }
+    double u[3];
+    vertexDisplacement(s, vertices[k], u);
+    for (int c = 0; c < 3; ++c) positions[3 * k + c] = static_cast<float>(s->model->rest[3 * vertices[k] + c] + u[c]);
   }
   return QV_OK;
 }

@@ -20,6 +20,7 @@ struct qv_model {
   const unsigned* vertexMap;
   const double* gravity;
   const double* eigenvalues;
+  const double* rotations;  // 3n x r row-major modal rotations, or null
 };
 
 namespace {
@@ -55,7 +56,8 @@ qv_result build(const quiver::ModelView& view, const qv_model_config& config, co
                        roundUp(quiver::rt::ReducedPolynomial::storageBytes(in.r, single)) +
                        roundUp(basisBytes) + roundUp(3 * n * sizeof(double)) +
                        roundUp(3 * size_t(in.triangleCount) * sizeof(unsigned)) + roundUp(n * sizeof(unsigned)) +
-                       roundUp(3 * r * sizeof(double)) + roundUp(size_t(in.eigenvalueCount) * sizeof(double));
+                       roundUp(3 * r * sizeof(double)) + roundUp(size_t(in.eigenvalueCount) * sizeof(double)) +
+                       (view.rotations ? roundUp(3 * n * r * sizeof(double)) : 0);
   char* block = static_cast<char*>(allocator.allocate(bytes, 64, allocator.user));
   if (!block) return QV_ERROR_OUT_OF_MEMORY;
   qv_model* m = new (block) qv_model{};
@@ -63,7 +65,7 @@ qv_result build(const quiver::ModelView& view, const qv_model_config& config, co
   m->info = qv_model_info{static_cast<int>(in.r), static_cast<int>(in.vertexCount), static_cast<int>(in.tetCount),
                           static_cast<int>(in.triangleCount), static_cast<int>(in.fileVertexCount),
                           static_cast<int>(in.eigenvalueCount), static_cast<int>(in.basisPrecision),
-                          static_cast<int>(in.materialIsUniform), in.youngsModulus, in.poissonRatio, in.density,
+                          static_cast<int>(in.materialIsUniform), view.rotations ? 1 : 0, in.youngsModulus, in.poissonRatio, in.density,
                           in.totalMass, in.rayleighAlpha, in.rayleighBeta, in.timeStep,
                           {in.bboxMin[0], in.bboxMin[1], in.bboxMin[2]}, {in.bboxMax[0], in.bboxMax[1], in.bboxMax[2]}};
   char* cursor = block + roundUp(sizeof(qv_model));
@@ -78,6 +80,7 @@ qv_result build(const quiver::ModelView& view, const qv_model_config& config, co
   m->vertexMap = place(cursor, reinterpret_cast<const unsigned*>(view.vertexMap), n);
   m->gravity = place(cursor, view.gravity, 3 * r);
   m->eigenvalues = place(cursor, view.eigenvalues, in.eigenvalueCount);
+  m->rotations = view.rotations ? place(cursor, view.rotations, 3 * n * r) : nullptr;
   *out = m;
   return QV_OK;
 }

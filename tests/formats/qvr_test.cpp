@@ -201,5 +201,35 @@ TEST(Qvr, SeedsOfTheIndependentPythonWriterParse) {
   }
 }
 
+// MODAL_ROTATIONS (type 10) is written with the optional flag, read back exactly, and a reader that
+// did not know the type would skip it: the flag bit is set in its table entry.
+TEST(Qvr, ModalRotationsRoundTripAsAnOptionalSection) {
+  ModelContents c = test::syntheticModel();
+  c.rotations = test::values(3 * size_t{c.info.vertexCount} * c.info.r, 99, 0.5, false);
+  const std::string bytes = formatModel(c);
+  const std::vector<unsigned char> buffer(bytes.begin(), bytes.end());
+  ModelView view;
+  std::string error;
+  ASSERT_TRUE(parseModel(buffer.data(), buffer.size(), view, error)) << error;
+  ASSERT_NE(view.rotations, nullptr);
+  EXPECT_EQ(0, std::memcmp(view.rotations, c.rotations.data(), c.rotations.size() * sizeof(double)));
+  uint64_t table = 0;
+  uint32_t count = 0;
+  std::memcpy(&table, &bytes[qvr::kTableOffsetAt], 8);
+  std::memcpy(&count, &bytes[qvr::kSectionCountAt], 4);
+  bool found = false;
+  for (uint32_t s = 0; s < count; ++s) {
+    uint32_t type = 0, flags = 0;
+    std::memcpy(&type, &bytes[table + s * qvr::kSectionEntrySize + qvr::kTypeAt], 4);
+    std::memcpy(&flags, &bytes[table + s * qvr::kSectionEntrySize + qvr::kFlagsAt], 4);
+    if (type == qvr::kModalRotations) found = (flags & qvr::kOptionalSection) != 0;
+  }
+  EXPECT_TRUE(found);
+  c.rotations.pop_back();
+  EXPECT_THROW(formatModel(c), std::runtime_error);  // wrong size: refused like any other section
+  EXPECT_EQ(copyModel(view).rotations.size(), 3 * size_t{c.info.vertexCount} * c.info.r);
+}
+
 } // namespace
 } // namespace quiver
+

@@ -60,6 +60,7 @@ typedef struct qv_model_info {
   int eigenvalue_count;
   int basis_precision;       /* 32 or 64 bits per stored basis entry */
   int material_is_uniform;   /* 1: one material; 0: mixed (the values below are volume-weighted means) */
+  int has_modal_rotations;   /* 1: the model can be simulated with modal warping */
   double youngs_modulus;     /* Pa */
   double poisson_ratio;
   double density;            /* kg/m^3 */
@@ -134,6 +135,9 @@ typedef struct qv_instance_config {
   double max_displacement;   /* m; a step that moves a vertex farther resets the instance; default 100 x the model's diagonal */
   int linear;                /* non-zero: linear modal dynamics, R(q) = K(0) q (small-strain elasticity in the same
                                 subspace, for comparison); default 0: St.Venant-Kirchhoff */
+  int warping;               /* non-zero: modal warping (Choi & Ko 2005): linear dynamics, each vertex's displacement
+                                rotated by its local rotation, forces rotated into the local frames; needs a model
+                                with modal rotations; default 0 */
 } qv_instance_config;
 
 /* Defaults for `model` (pass NULL for model-independent defaults). */
