@@ -108,6 +108,10 @@ int main(int argc, char** argv) {
                         "Sparse solver: llt, ldlt (Eigen Simplicial), cg (incomplete Cholesky), lu (SparseLU)")
       ->capture_default_str()
       ->check(CLI::IsMember({"llt", "ldlt", "cg", "lu"}));
+  fullSpace->add_option("--elasticity", fullOptions.elasticity,
+                        "stvk, linear (K(0), the full linear system) or warping (linear + per-vertex modal warping)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"stvk", "linear", "warping"}));
   fullSpace->add_option("--E", fullOptions.material.youngsModulus, "Young's modulus in Pa; overrides the mesh file's");
   fullSpace->add_option("--nu", fullOptions.material.poissonRatio, "Poisson ratio; overrides the mesh file's");
   fullSpace->add_option("--density", fullOptions.material.density, "Density in kg/m^3; overrides the mesh file's");

@@ -29,7 +29,8 @@ public:
     return 0;
   }
   void displacement(std::vector<double>& u) const override {
-    u.assign(sim_.displacement().data(), sim_.displacement().data() + sim_.displacement().size());
+    const Eigen::VectorXd shown = sim_.displacement();
+    u.assign(shown.data(), shown.data() + shown.size());
   }
   void energies(double& kinetic, double& elastic) const override {
     kinetic = sim_.kineticEnergy();
@@ -49,6 +50,9 @@ int simulateFullSpace(const TetMesh& mesh, const std::vector<int>& fileVertex, s
                       const std::vector<int>& fixed, const FullSpaceOptions& full, const SimOptions& o) {
   FullSpaceSettings settings;
   settings.solver = parseSparseSolver(full.solver);
+  settings.elasticity = full.elasticity == "linear"    ? Elasticity::Linear
+                        : full.elasticity == "warping" ? Elasticity::Warping
+                                                       : Elasticity::StVK;
   if (o.timeStep > 0) settings.timeStep = o.timeStep;
   if (o.alpha >= 0) settings.rayleighAlpha = o.alpha;
   if (o.beta >= 0) settings.rayleighBeta = o.beta;
@@ -58,7 +62,7 @@ int simulateFullSpace(const TetMesh& mesh, const std::vector<int>& fileVertex, s
     if (std::string bad = checkMaterial(m); !bad.empty()) throw std::runtime_error(bad);
   FullSpaceTarget target(mesh, perTet, fixed, settings);
   const ScenarioResult result = runScenario(target, mesh, o);
-  const Eigen::VectorXd& u = target.simulator().displacement();
+  const Eigen::VectorXd u = target.simulator().displacement();
   if (!full.finalNpy.empty()) {
     std::vector<double> rows(3 * fileVertexCount, 0.0);
     for (size_t v = 0; v < fileVertex.size(); ++v)
@@ -71,6 +75,7 @@ int simulateFullSpace(const TetMesh& mesh, const std::vector<int>& fileVertex, s
     nlohmann::ordered_json j;
     j["dofs"] = target.simulator().dofCount();
     j["solver"] = full.solver;
+    j["elasticity"] = full.elasticity;
     j["steps"] = o.steps;
     j["time_step_s"] = settings.timeStep;
     j["step_ms_mean"] = 1e-3 * total / o.steps;

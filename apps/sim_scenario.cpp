@@ -21,7 +21,10 @@ void SimOptions::addTo(CLI::App& app) {
   app.add_option("--group", group, "Loaded vertices, a selector such as \"x>max-1e-6\" (mesh units)")->capture_default_str();
   app.add_option("--force", force, "Pull: total force on the group, N, as fx,fy,fz")->delimiter(',')->expected(3);
   app.add_option("--drag", drag, "Drag: move the group's targets by dx,dy,dz (m) over the hold")->delimiter(',')->expected(3);
-  app.add_option("--twist", twist, "Drag: rotate the group's targets by this many degrees about x over the hold");
+  app.add_option("--twist", twist, "Drag: rotate the group's targets by this many degrees over the hold");
+  app.add_option("--axis", axis, "Drag: the twist axis, through the group's centre")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"x", "y", "z"}));
   app.add_option("--stiffness", stiffness, "Drag: penalty spring per vertex, N/m")->capture_default_str();
   app.add_flag("--gravity", gravity, "Gravity, 9.81 m/s^2 along -z");
   app.add_option("--dt", timeStep, "Time step, s")->check(CLI::PositiveNumber);
@@ -67,7 +70,8 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
   for (int step = 0; step < o.steps; ++step) {
     if (step < o.holdSteps && dragMode) {
       const double s = static_cast<double>(step + 1) / o.holdSteps;
-      const Eigen::Matrix3d R = Eigen::AngleAxisd(s * o.twist * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+      const Eigen::Vector3d axis = Eigen::Vector3d::Unit(o.axis[0] - 'x');
+      const Eigen::Matrix3d R = Eigen::AngleAxisd(s * o.twist * M_PI / 180, axis).toRotationMatrix();
       for (size_t k = 0; k < group.size(); ++k) {
         const Eigen::Vector3d x = centre + R * (mesh.vertices[group[k]] - centre) + s * Eigen::Vector3d(o.drag.data());
         for (int c = 0; c < 3; ++c) targets[3 * k + c] = x[c];

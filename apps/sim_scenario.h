@@ -18,7 +18,8 @@ struct SimOptions {
   std::string group = "x>max-1e-6";     // vertex selector (common/vertex_selector.h) for the loaded group
   std::vector<double> force{0, 0, 0};   // N, total force spread over the group (pull mode)
   std::vector<double> drag{0, 0, 0};    // m, group targets moved by this much (drag mode)
-  double twist = 0;                     // degrees about the x axis through the group's centre (drag mode)
+  double twist = 0;                     // degrees about `axis` through the group's centre (drag mode)
+  std::string axis = "x";               // x | y | z: the twist axis
   double stiffness = 1e4;               // N/m per vertex, drag mode's penalty springs
   bool gravity = false;                 // add g = 9.81 m/s^2 along -z
   double timeStep = 0;                  // s; 0: the simulator's default
@@ -66,6 +67,7 @@ int simulateModel(const std::string& modelPath, const std::string& integrator, c
 
 struct FullSpaceOptions {
   std::string solver = "ldlt";          // llt | ldlt | cg | lu
+  std::string elasticity = "stvk";      // stvk | linear | warping (linear + per-vertex modal warping)
   MaterialOverride material;            // over the mesh file's materials
   std::string finalNpy;                 // save the final displacement (3N, the file's vertex order)
 };

@@ -7,6 +7,8 @@
 #include <Eigen/SparseLU>
 
 #include "common/mass_matrix.h"
+#include "common/modal_rotation.h"
+#include "formats/model/modal_warping.h"
 
 namespace quiver {
 
@@ -31,12 +33,14 @@ SparseSolver parseSparseSolver(const std::string& name) {
 
 FullSpaceSimulator::FullSpaceSimulator(const TetMesh& mesh, const std::vector<Material>& perTet,
                                        const std::vector<int>& fixedVertices, const FullSpaceSettings& settings)
-    : model_(mesh, perTet), settings_(settings), rest_(mesh.vertices), solvers_(std::make_unique<Solvers>()) {
+    : model_(mesh, perTet), settings_(settings), rest_(mesh.vertices), mesh_(mesh),
+      solvers_(std::make_unique<Solvers>()) {
   if (!(settings.timeStep > 0) || settings.maxNewtonIterations < 1)
     throw std::invalid_argument("full-space simulator: time step must be > 0 and Newton iterations >= 1");
   const int n = model_.dofCount();
   u_ = v_ = a_ = stepForce_ = gravityForce_ = Eigen::VectorXd::Zero(n);
   tangent_ = model_.tangentStiffness(u_);
+  restStiffness_ = tangent_;
   // The mass pattern lies inside the tangent's (both couple vertices sharing a tet): adding a zero
   // tangent puts M on the same pattern, so the system is a sum of value arrays.
   mass_ = consistentMassMatrix(mesh, perTet) + 0.0 * tangent_;
@@ -58,7 +62,25 @@ FullSpaceSimulator::~FullSpaceSimulator() = default;
 
 void FullSpaceSimulator::addVertexForce(int vertex, const Eigen::Vector3d& force) {
   if (vertex < 0 || 3 * vertex >= dofCount()) throw std::invalid_argument("addVertexForce: no such vertex");
-  stepForce_.segment<3>(3 * vertex) += force;
+  Eigen::Vector3d local = force;
+  if (settings_.elasticity == Elasticity::Warping) {  // into the vertex's rotated frame
+    const Eigen::Vector3d back = -vertexRotations(mesh_, u_).middleRows(3 * vertex, 3);
+    warping::rotate(back.data(), force.data(), local.data());
+  }
+  stepForce_.segment<3>(3 * vertex) += local;
+}
+
+Eigen::VectorXd FullSpaceSimulator::displacement() const {
+  if (settings_.elasticity != Elasticity::Warping) return u_;
+  const Eigen::MatrixXd w = vertexRotations(mesh_, u_);
+  Eigen::VectorXd out(u_.size());
+  for (int v = 0; 3 * v < dofCount(); ++v)
+    warping::warpDisplacement(w.col(0).data() + 3 * v, u_.data() + 3 * v, out.data() + 3 * v);
+  return out;
+}
+
+double FullSpaceSimulator::elasticEnergy() const {
+  return settings_.elasticity == Elasticity::StVK ? model_.energy(u_) : 0.5 * u_.dot(restStiffness_ * u_);
 }
 
 void FullSpaceSimulator::setGravity(const Eigen::Vector3d& g) {
@@ -136,8 +158,12 @@ int FullSpaceSimulator::step() {
   auto residualAt = [&](const Eigen::VectorXd& acc, Eigen::VectorXd& out, bool withTangent) {
     q = u_ + h * v_ + h * h * ((0.5 - beta) * a_ + beta * acc);
     vel = v_ + h * ((1 - gamma) * a_ + gamma * acc);
-    model_.internalForce(q, force_);
-    if (withTangent) model_.tangentStiffness(q, tangent_);
+    if (settings_.elasticity == Elasticity::StVK) {
+      model_.internalForce(q, force_);
+      if (withTangent) model_.tangentStiffness(q, tangent_);
+    } else {
+      force_ = restStiffness_ * q;  // tangent_ stays K(0)
+    }
     for (size_t k = 0; k < springVertices_.size(); ++k) {
       const int v = springVertices_[k];
       force_.segment<3>(3 * v) += springStiffness_ * (rest_[v] + q.segment<3>(3 * v) - springTargets_[k]);

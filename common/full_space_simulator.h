@@ -20,6 +20,10 @@ namespace quiver {
 
 enum class SparseSolver { LLT, LDLT, CG, LU };
 
+// St.Venant-Kirchhoff; linear elasticity (R = K(0) u); or linear elasticity with per-vertex modal
+// warping of the output (Choi & Ko 2005, every free DOF a mode: the full linear system).
+enum class Elasticity { StVK, Linear, Warping };
+
 // "llt", "ldlt", "cg", "lu"; throws std::invalid_argument for anything else.
 SparseSolver parseSparseSolver(const std::string& name);
 
@@ -30,6 +34,7 @@ struct FullSpaceSettings {
   int maxNewtonIterations = 20;    // per step
   double newtonTolerance = 1e-8;   // stop when ||residual|| <= tolerance * (||M a|| + ||f|| + tiny)
   SparseSolver solver = SparseSolver::LDLT;
+  Elasticity elasticity = Elasticity::StVK;
   double cgTolerance = 1e-12;      // relative residual of each CG solve
 };
 
@@ -50,10 +55,12 @@ public:
   // solver fails (e.g. SimplicialLLT on an indefinite tangent) or Newton does not converge.
   int step();
 
-  const Eigen::VectorXd& displacement() const { return u_; }
+  // The displacement to show: u, or under warping each vertex's u rotated by its local rotation
+  // (1/2 curl u, volume-averaged over its tets).
+  Eigen::VectorXd displacement() const;
   const Eigen::VectorXd& velocity() const { return v_; }
   double kineticEnergy() const;
-  double elasticEnergy() const { return model_.energy(u_); }
+  double elasticEnergy() const;
   int dofCount() const { return model_.dofCount(); }
 
 private:
@@ -70,6 +77,8 @@ private:
   std::vector<Eigen::Vector3d> springTargets_;
   double springStiffness_ = 0;
   std::vector<Eigen::Vector3d> rest_;
+  TetMesh mesh_;                       // for the rotations of warping
+  Eigen::SparseMatrix<double> restStiffness_;  // K(0), for linear elasticity and warping
   std::vector<int> diagonalSlot_;      // value-array index of each DOF's diagonal entry
   struct Solvers;
   std::unique_ptr<Solvers> solvers_;

@@ -2,9 +2,7 @@
 
 namespace quiver {
 
-Eigen::Matrix3d greenStrain(const Eigen::Matrix3d& F) {
-  return 0.5 * (F.transpose() * F - Eigen::Matrix3d::Identity());
-}
+Eigen::Matrix3d greenStrain(const Eigen::Matrix3d& H) { return 0.5 * (H + H.transpose() + H.transpose() * H); }
 
 Eigen::Matrix3d stvkSecondPiolaKirchhoff(const Eigen::Matrix3d& E, double lambda, double mu) {
   return 2 * mu * E + lambda * E.trace() * Eigen::Matrix3d::Identity();
@@ -15,12 +13,14 @@ double stvkEnergyDensity(const Eigen::Matrix3d& E, double lambda, double mu) {
   return mu * E.squaredNorm() + 0.5 * lambda * trace * trace;
 }
 
-Matrix34 stvkElementForce(const Eigen::Matrix3d& F, const Matrix34& G, double V, double lambda, double mu) {
-  return V * F * stvkSecondPiolaKirchhoff(greenStrain(F), lambda, mu) * G;
+Matrix34 stvkElementForce(const Eigen::Matrix3d& H, const Matrix34& G, double V, double lambda, double mu) {
+  const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + H;
+  return V * F * stvkSecondPiolaKirchhoff(greenStrain(H), lambda, mu) * G;
 }
 
-Matrix12 stvkElementTangent(const Eigen::Matrix3d& F, const Matrix34& G, double V, double lambda, double mu) {
-  const Eigen::Matrix3d S = stvkSecondPiolaKirchhoff(greenStrain(F), lambda, mu);
+Matrix12 stvkElementTangent(const Eigen::Matrix3d& H, const Matrix34& G, double V, double lambda, double mu) {
+  const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + H;
+  const Eigen::Matrix3d S = stvkSecondPiolaKirchhoff(greenStrain(H), lambda, mu);
   // Differentiating V P g_a = V F S g_a along u_b gives a geometric term (S fixed, F moves)
   // and a material term (S moves with E); both reduce to these small products.
   const Eigen::Matrix4d GSG = G.transpose() * S * G;

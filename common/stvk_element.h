@@ -4,8 +4,8 @@
 // of modal derivatives). StVKForceModel assembles them over a whole mesh; the bake assembles them
 // over the tets each MPI rank owns.
 //
-// With F = I + \sum_a u_a g_a^T constant on the tet (see tet_elements.h):
-//   E = \tfrac12 (F^T F - I),  S = 2\mu E + \lambda \operatorname{tr}(E) I,  P = F S,
+// With the displacement gradient H = \sum_a u_a g_a^T constant on the tet and F = I + H:
+//   E = \tfrac12 (H + H^T + H^T H),  S = 2\mu E + \lambda \operatorname{tr}(E) I,  P = F S,
 //   W = \mu E:E + \tfrac{\lambda}{2} (\operatorname{tr} E)^2,  f_a = V P g_a.
 #include <Eigen/Core>
 
@@ -15,8 +15,9 @@ namespace quiver {
 
 using Matrix12 = Eigen::Matrix<double, 12, 12>;
 
-// Green strain E = \tfrac12 (F^T F - I).
-Eigen::Matrix3d greenStrain(const Eigen::Matrix3d& F);
+// Green strain from the displacement gradient H = F - I: E = \tfrac12 (H + H^T + H^T H), the same as
+// \tfrac12 (F^T F - I) but without its cancellation: at strains of 1e-8 the latter keeps half the digits.
+Eigen::Matrix3d greenStrain(const Eigen::Matrix3d& H);
 
 // StVK second Piola-Kirchhoff stress S = \partial W / \partial E = 2 \mu E + \lambda \operatorname{tr}(E) I.
 Eigen::Matrix3d stvkSecondPiolaKirchhoff(const Eigen::Matrix3d& E, double lambda, double mu);
@@ -24,12 +25,12 @@ Eigen::Matrix3d stvkSecondPiolaKirchhoff(const Eigen::Matrix3d& E, double lambda
 // StVK energy density W = \mu E:E + \tfrac{\lambda}{2} (\operatorname{tr} E)^2, per unit rest volume.
 double stvkEnergyDensity(const Eigen::Matrix3d& E, double lambda, double mu);
 
-// Nodal internal forces f_a = V P g_a (column a), P = F S(E(F)).
-Matrix34 stvkElementForce(const Eigen::Matrix3d& F, const Matrix34& G, double V, double lambda, double mu);
+// Nodal internal forces f_a = V P g_a (column a), P = F S(E), for the displacement gradient H.
+Matrix34 stvkElementForce(const Eigen::Matrix3d& H, const Matrix34& G, double V, double lambda, double mu);
 
 // Element tangent \partial f / \partial u_e (rows and columns 3a + i), symmetric:
 //   K^{ab} = V [ (g_a^T S g_b) I + \mu (g_a \cdot g_b) F F^T + \mu F g_b (F g_a)^T + \lambda F g_a (F g_b)^T ].
-Matrix12 stvkElementTangent(const Eigen::Matrix3d& F, const Matrix34& G, double V, double lambda, double mu);
+Matrix12 stvkElementTangent(const Eigen::Matrix3d& H, const Matrix34& G, double V, double lambda, double mu);
 
 // Second derivative of the nodal forces at rest along displacements a and b of the tet's
 // vertices (columns as in tetDisplacements()): d^2 f [a, b] = \partial_s \partial_t f(s a + t b)

@@ -71,8 +71,8 @@ double StVKForceModel::energy(const Eigen::VectorXd& u) const {
   checkSize(u);
   double sum = 0;
   for (size_t t = 0; t < tets_.size(); ++t) {
-    const Eigen::Matrix3d F = deformationGradient(tetDisplacements(tets_[t], u), elements_.gradients[t]);
-    sum += elements_.volume[t] * stvkEnergyDensity(greenStrain(F), lambda_[t], mu_[t]);
+    const Eigen::Matrix3d H = displacementGradient(tetDisplacements(tets_[t], u), elements_.gradients[t]);
+    sum += elements_.volume[t] * stvkEnergyDensity(greenStrain(H), lambda_[t], mu_[t]);
   }
   return sum;
 }
@@ -82,8 +82,8 @@ void StVKForceModel::internalForce(const Eigen::VectorXd& u, Eigen::VectorXd& f)
   f.setZero(dofCount());
   for (size_t t = 0; t < tets_.size(); ++t) {
     const Matrix34& G = elements_.gradients[t];
-    const Eigen::Matrix3d F = deformationGradient(tetDisplacements(tets_[t], u), G);
-    const Matrix34 fe = stvkElementForce(F, G, elements_.volume[t], lambda_[t], mu_[t]);
+    const Eigen::Matrix3d H = displacementGradient(tetDisplacements(tets_[t], u), G);
+    const Matrix34 fe = stvkElementForce(H, G, elements_.volume[t], lambda_[t], mu_[t]);
     for (int a = 0; a < 4; ++a) f.segment<3>(3 * tets_[t][a]) += fe.col(a);
   }
 }
@@ -116,8 +116,8 @@ void StVKForceModel::tangentStiffness(const Eigen::VectorXd& u, Eigen::SparseMat
 
   for (size_t t = 0; t < tets_.size(); ++t) {
     const Matrix34& G = elements_.gradients[t];
-    const Eigen::Matrix3d F = deformationGradient(tetDisplacements(tets_[t], u), G);
-    const Matrix12 Ke = stvkElementTangent(F, G, elements_.volume[t], lambda_[t], mu_[t]);
+    const Eigen::Matrix3d H = displacementGradient(tetDisplacements(tets_[t], u), G);
+    const Matrix12 Ke = stvkElementTangent(H, G, elements_.volume[t], lambda_[t], mu_[t]);
     const int* slot = &slots_[144 * t];
     for (int k = 0; k < 144; ++k) values[slot[k]] += Ke.data()[k];
   }

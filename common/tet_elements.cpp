@@ -36,8 +36,8 @@ Matrix34 tetDisplacements(const Tet& tet, const Eigen::VectorXd& u) {
   return ue;
 }
 
-Eigen::Matrix3d deformationGradient(const Matrix34& ue, const Matrix34& gradients) {
-  return Eigen::Matrix3d::Identity() + ue * gradients.transpose();
+Eigen::Matrix3d displacementGradient(const Matrix34& ue, const Matrix34& gradients) {
+  return ue * gradients.transpose();
 }
 
 } // namespace quiver

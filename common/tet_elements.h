@@ -34,8 +34,8 @@ TetElements computeTetElements(const TetMesh& mesh);
 // `u` in the DOF order dof = 3 * vertex + component.
 Matrix34 tetDisplacements(const Tet& tet, const Eigen::VectorXd& u);
 
-// Deformation gradient F = I + \sum_a u_a g_a^T = I + U_e G^T, with U_e = tetDisplacements()
-// and G = TetElements::gradients of the same tet.
-Eigen::Matrix3d deformationGradient(const Matrix34& ue, const Matrix34& gradients);
+// Displacement gradient H = \sum_a u_a g_a^T = U_e G^T, with U_e = tetDisplacements() and
+// G = TetElements::gradients of the same tet; the deformation gradient is F = I + H.
+Eigen::Matrix3d displacementGradient(const Matrix34& ue, const Matrix34& gradients);
 
 } // namespace quiver

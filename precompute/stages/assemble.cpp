@@ -59,7 +59,7 @@ AssembledSystem assembleSystem(const TetMesh& mesh, const std::vector<Material>&
   AssembledSystem sys{createMatrix(layout, diagonal, offDiagonal), createMatrix(layout, diagonal, offDiagonal)};
 
   const TetElements elements = computeTetElements(mesh);
-  const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d atRest = Eigen::Matrix3d::Zero();  // displacement gradient at rest
   PetscInt dofs[12];
   Eigen::Matrix<double, 12, 12, Eigen::RowMajor> Ke, Me;
   for (int t = 0; t < mesh.tetCount(); ++t) {
@@ -68,7 +68,7 @@ AssembledSystem assembleSystem(const TetMesh& mesh, const std::vector<Material>&
       for (int c = 0; c < 3; ++c) dofs[3 * a + c] = static_cast<PetscInt>(layout.dof(mesh.tets[t][a], c));
     const Material& m = perTet[t];
     const double V = elements.volume[t];
-    Ke = stvkElementTangent(identity, elements.gradients[t], V, m.lambda(), m.mu());
+    Ke = stvkElementTangent(atRest, elements.gradients[t], V, m.lambda(), m.mu());
     Me.setZero();
     for (int a = 0; a < 4; ++a)
       for (int b = 0; b < 4; ++b)

@@ -4,7 +4,7 @@
 #include <new>
 
 #include "dense_solve.h"
-#include "modal_warping.h"
+#include "formats/model/modal_warping.h"
 #include "quiver/quiver.h"
 
 namespace {
@@ -239,7 +239,7 @@ void vertexDisplacement(const qv_instance* s, int v, double u[3]) {
   }
   double d[3], w[3];
   vertexLinear(s->model, v, s->q, d, w);
-  quiver::rt::warpDisplacement(w, d, u);
+  quiver::warping::warpDisplacement(w, d, u);
 }
 
 bool validConfig(const qv_model* model, const qv_instance_config* c) {
@@ -392,17 +392,11 @@ qv_step_status qv_instance_step(qv_instance* s) {
 qv_result qv_instance_add_vertex_force(qv_instance* s, int vertex, const double force[3]) {
   if (!s || !force || vertex < 0 || vertex >= s->model->info.vertex_count) return QV_ERROR_INVALID_ARGUMENT;
   double local[3] = {force[0], force[1], force[2]};
-  if (s->config.warping) {
-    // Into the vertex's rotated frame: R(w)^T f, the rotation by -w (Rodrigues).
-    double d[3], w[3], axis[3], c1[3], c2[3];
+  if (s->config.warping) {  // into the vertex's rotated frame: R(w)^T f, the rotation by -w
+    double d[3], w[3];
     vertexLinear(s->model, vertex, s->q, d, w);
-    const double angle = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-    if (angle > 0) {
-      for (int c = 0; c < 3; ++c) axis[c] = -w[c] / angle;
-      quiver::rt::cross3(axis, force, c1);
-      quiver::rt::cross3(axis, c1, c2);
-      for (int c = 0; c < 3; ++c) local[c] = force[c] + std::sin(angle) * c1[c] + (1 - std::cos(angle)) * c2[c];
-    }
+    const double back[3] = {-w[0], -w[1], -w[2]};
+    quiver::warping::rotate(back, force, local);
   }
   for (int j = 0; j < s->r; ++j)
     for (int c = 0; c < 3; ++c) s->stepForce[j] += basisEntry(s->model, 3 * static_cast<size_t>(vertex) + c, j) * local[c];

@@ -6,6 +6,8 @@
 #include <Eigen/SparseCholesky>
 
 #include <algorithm>
+#include <cstdio>
+#include <map>
 
 #include "common/box_mesh.h"
 #include "common/full_space_simulator.h"
@@ -109,4 +111,50 @@ TEST(FullSpaceSimulator, DampedMotionSettlesOnTheStaticEquilibrium) {
     u(free) -= K.ldlt().solve(r);
   }
   EXPECT_LT((sim.displacement() - u).norm(), 1e-6 * u.norm());
+}
+
+// Linear elasticity and modal warping in full space: at a tiny load they agree with StVK; at a
+// large one linear displacements stretch the bar's centre line and warping keeps its length.
+TEST(FullSpaceSimulator, LinearAndWarpedElasticity) {
+  Bar bar;
+  auto settle = [&](Elasticity elasticity, double newtons) {
+    FullSpaceSettings s;
+    s.elasticity = elasticity;
+    s.rayleighAlpha = 40;
+    s.newtonTolerance = 1e-10;
+    FullSpaceSimulator sim(bar.mesh, bar.perTet, bar.fixed, s);
+    for (int step = 0; step < 1500; ++step) {
+      bar.pull(sim, newtons);
+      sim.step();
+    }
+    return sim.displacement();
+  };
+  // Length of the line through the cross-sections' centroids (the neutral axis), relative to 0.4 m.
+  auto centreLine = [&](const Eigen::VectorXd& u) {
+    std::map<double, std::pair<Eigen::Vector3d, int>> sections;
+    for (int v = 0; v < bar.mesh.vertexCount(); ++v) {
+      auto& [sum, count] = sections[bar.mesh.vertices[v].x()];
+      if (count == 0) sum.setZero();
+      sum += bar.mesh.vertices[v] + u.segment<3>(3 * v);
+      ++count;
+    }
+    double length = 0;
+    Eigen::Vector3d previous;
+    bool first = true;
+    for (const auto& [x, entry] : sections) {
+      const Eigen::Vector3d centre = entry.first / entry.second;
+      if (!first) length += (centre - previous).norm();
+      previous = centre;
+      first = false;
+    }
+    return length / 0.4 - 1;
+  };
+  const Eigen::VectorXd tinyStvk = settle(Elasticity::StVK, 1e-3), tinyLinear = settle(Elasticity::Linear, 1e-3),
+                        tinyWarped = settle(Elasticity::Warping, 1e-3);
+  EXPECT_LT((tinyLinear - tinyStvk).norm(), 1e-3 * tinyStvk.norm());
+  EXPECT_LT((tinyWarped - tinyLinear).norm(), 1e-3 * tinyLinear.norm());
+  const double linear = centreLine(settle(Elasticity::Linear, 12.0)), warped = centreLine(settle(Elasticity::Warping, 12.0));
+  EXPECT_GT(linear, 0.02);
+  EXPECT_LT(std::abs(warped), 0.3 * linear);
+  std::printf("full space, centre line under a large pull: linear %+.2f%%, warped %+.2f%%\n", 100 * linear, 100 * warped);
 }

@@ -116,7 +116,7 @@ TEST(StVKForceModel, StressFunctionsMatchUniaxialStretch) {
   // F = diag(s, 1, 1): E_xx = (s^2 - 1)/2, S = diag(lambda + 2 mu, lambda, lambda) E_xx,
   // W = (mu + lambda/2) E_xx^2.
   const double s = 1.3, lambda = 2.0, mu = 0.7, exx = (s * s - 1) / 2;
-  const Eigen::Matrix3d E = greenStrain(Eigen::Vector3d(s, 1, 1).asDiagonal());
+  const Eigen::Matrix3d E = greenStrain(Eigen::Vector3d(s - 1, 0, 0).asDiagonal());  // F = diag(s, 1, 1)
   EXPECT_LT((E - Eigen::Vector3d(exx, 0, 0).asDiagonal().toDenseMatrix()).norm(), 1e-15);
   const Eigen::Matrix3d S = stvkSecondPiolaKirchhoff(E, lambda, mu);
   EXPECT_LT((S - Eigen::Vector3d(lambda + 2 * mu, lambda, lambda).asDiagonal().toDenseMatrix() * exx).norm(), 1e-14);

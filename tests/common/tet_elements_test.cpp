@@ -85,7 +85,7 @@ TEST(TetElements, DeformationGradientOfAffineMapIsItsMatrix) {
   for (int a = 0; a < 4; ++a) u.segment<3>(3 * a) = (A - Eigen::Matrix3d::Identity()) * mesh.vertices[a] + shift;
   const Matrix34 ue = tetDisplacements(mesh.tets[0], u);
   EXPECT_EQ(ue.col(2), u.segment<3>(6));
-  EXPECT_LT((deformationGradient(ue, el.gradients[0]) - A).norm(), 1e-13);
+  EXPECT_LT((Eigen::Matrix3d::Identity() + displacementGradient(ue, el.gradients[0]) - A).norm(), 1e-13);
 }
 
 TEST(TetElements, DegenerateTetIsRejected) {

@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "runtime/src/modal_warping.h"
+#include "formats/model/modal_warping.h"
 
-using quiver::rt::warpDisplacement;
+using quiver::warping::warpDisplacement;
 
 // The warped displacement of a point under the rotation w, from the linear one w x X: the rotated
 // point R(w) X - X exactly, R the finite rotation by |w| about w; and no change for tiny rotations.
