@@ -149,7 +149,29 @@ void FullSpaceSimulator::solve(const SparseMatrix& A, const Eigen::VectorXd& b, 
 }
 
 int FullSpaceSimulator::step() {
-  const double h = settings_.timeStep, beta = 0.25, gamma = 0.5;
+  const int iterations = advance(settings_.timeStep, 0);
+  stepForce_.setZero();
+  return iterations;
+}
+
+int FullSpaceSimulator::advance(double h, int depth) {
+  constexpr int kMaxHalvings = 6;
+  const Eigen::VectorXd u = u_, v = v_, a = a_;
+  try {
+    return newmarkStep(h);
+  } catch (const NewtonFailure&) {
+    // Sudden changes (a released spring, a twist) can defeat Newton from the last acceleration:
+    // take the step as two halves instead, down to 1/64 of it.
+    if (depth >= kMaxHalvings) throw;
+    u_ = u;
+    v_ = v;
+    a_ = a;
+    return advance(h / 2, depth + 1) + advance(h / 2, depth + 1);
+  }
+}
+
+int FullSpaceSimulator::newmarkStep(double h) {
+  const double beta = 0.25, gamma = 0.5;
   const double alpha = settings_.rayleighAlpha, betaK = settings_.rayleighBeta;
   const Eigen::VectorXd external = stepForce_ + gravityForce_;
   Eigen::VectorXd next = a_, q, vel, residual, delta, trialResidual;
@@ -179,7 +201,6 @@ int FullSpaceSimulator::step() {
       u_ = q;
       v_ = vel;
       a_ = next;
-      stepForce_.setZero();
       return it;
     }
     if (it == settings_.maxNewtonIterations) break;
@@ -203,8 +224,8 @@ int FullSpaceSimulator::step() {
     }
     next += step * delta;
   }
-  throw std::runtime_error("full-space simulator: Newton did not converge in " +
-                           std::to_string(settings_.maxNewtonIterations) + " iterations");
+  throw NewtonFailure("full-space simulator: Newton did not converge in " +
+                      std::to_string(settings_.maxNewtonIterations) + " iterations, even on 1/64 of the time step");
 }
 
 } // namespace quiver

@@ -9,6 +9,7 @@
 // identity on the tangent's fixed pattern, so the sparsity pattern (and a direct solver's
 // symbolic factorisation, computed once) never changes.
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -51,8 +52,10 @@ public:
   void setSprings(const std::vector<int>& vertices, const std::vector<Eigen::Vector3d>& targets, double stiffness);
   void clearSprings();
 
-  // One time step; returns the Newton iterations used. Throws std::runtime_error when the linear
-  // solver fails (e.g. SimplicialLLT on an indefinite tangent) or Newton does not converge.
+  // One time step; returns the Newton iterations used (over all substeps). When Newton does not
+  // converge the step is retried as two half steps, recursively down to 1/64 of it. Throws
+  // std::runtime_error when the linear solver fails (e.g. SimplicialLLT on an indefinite tangent)
+  // or Newton fails even then.
   int step();
 
   // The displacement to show: u, or under warping each vertex's u rotated by its local rotation
@@ -64,6 +67,11 @@ public:
   int dofCount() const { return model_.dofCount(); }
 
 private:
+  struct NewtonFailure : std::runtime_error {
+    using std::runtime_error::runtime_error;
+  };
+  int advance(double h, int depth);
+  int newmarkStep(double h);
   void applyConstraints(Eigen::SparseMatrix<double>& A, Eigen::VectorXd& b) const;
   void solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b, Eigen::VectorXd& x);
 
