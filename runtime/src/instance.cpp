@@ -460,7 +460,14 @@ void qv_instance_set_state(qv_instance* s, const double* q, const double* v, con
   if (!s) return;
   if (q) std::memcpy(s->q, q, sizeof(double) * s->r);
   if (v) std::memcpy(s->v, v, sizeof(double) * s->r);
-  if (a) std::memcpy(s->a, a, sizeof(double) * s->r);
+  if (a) {
+    std::memcpy(s->a, a, sizeof(double) * s->r);
+  } else if (q || v) {
+    // The acceleration the equations of motion give at the new state (persistent loads only), so
+    // that the next implicit step starts consistent rather than injecting energy.
+    s->evaluate(s->q, nullptr);
+    for (int i = 0; i < s->r; ++i) s->a[i] = s->gravityForce[i] - s->force[i] - s->damping(i, s->v);
+  }
 }
 
 void qv_instance_reset(qv_instance* s) {

@@ -91,9 +91,10 @@ TEST(Step, UndampedNewmarkKeepsEnergyBoundedOver10000Steps) {
     hi = std::max(hi, kinetic + elastic);
   }
   // The trapezoidal rule conserves energy exactly for linear systems; with StVK's nonlinearity at a
-  // 10% tip deflection it exchanges a few per cent with the discretisation but neither drifts nor grows.
-  EXPECT_GT(lo, 0.9 * initial);
-  EXPECT_LT(hi, 1.1 * initial);
+  // 10% tip deflection it exchanges about 1% with the discretisation but neither drifts nor grows.
+  // (set_state gave the consistent initial acceleration: with a = 0 the first step injects ~5%.)
+  EXPECT_GT(lo, 0.98 * initial);
+  EXPECT_LT(hi, 1.02 * initial);
   RecordProperty("energy_range", std::to_string(lo / initial) + " .. " + std::to_string(hi / initial));
 }
 

@@ -176,7 +176,9 @@ QV_API qv_result qv_instance_set_constraint(qv_instance* instance, int slot, con
                                             const double* targets, double stiffness);
 QV_API void qv_instance_clear_constraint(qv_instance* instance, int slot);
 
-/* State (r values each; any pointer may be NULL), reset to rest, and energies (J). */
+/* State (r values each; any pointer may be NULL: that part is left as it is, except that a NULL
+   acceleration with a new q or velocity is replaced by the one the equations of motion give there
+   under the persistent loads), reset to rest, and energies (J). */
 QV_API void qv_instance_get_state(const qv_instance* instance, double* q, double* velocity, double* acceleration);
 QV_API void qv_instance_set_state(qv_instance* instance, const double* q, const double* velocity,
                                   const double* acceleration);
