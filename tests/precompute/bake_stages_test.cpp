@@ -64,6 +64,16 @@ struct Problem {
     M = Mfull(freeRows, freeRows);
   }
 
+  LinearModes modes(int count) const {
+    ModeSettings settings;
+    settings.count = count;
+    return computeLinearModes(system.stiffness, system.mass, *layout, settings, rigid);
+  }
+  ModalDerivatives derivatives(const LinearModes& m) const {
+    return computeModalDerivatives(mesh, perTet, partition.tetPart, system.stiffness, system.mass, *layout, m, rigid,
+                                   DerivativeSettings{});
+  }
+
   // Local rows -> dense free-DOF vector(s) in vertex order, identical on every rank.
   Eigen::MatrixXd dense(const Eigen::MatrixXd& local) const { return layout->gatherToAll(local)(freeRows, Eigen::all); }
   Eigen::VectorXd fullVector(const Eigen::VectorXd& freeValues) const {
@@ -110,11 +120,8 @@ TEST_P(BakeStages, ModesMatchADenseGeneralizedEigenSolve) {
 TEST_P(BakeStages, DerivativesSolveTheDenseSystem) {
   const bool free = GetParam();
   Problem p(free);
-  ModeSettings ms;
-  ms.count = 3;
-  LinearModes modes = computeLinearModes(p.system.stiffness, p.system.mass, *p.layout, ms, p.rigid);
-  ModalDerivatives d = computeModalDerivatives(p.mesh, p.perTet, p.partition.tetPart, p.system.stiffness,
-                                               p.system.mass, *p.layout, modes, p.rigid, DerivativeSettings{});
+  const LinearModes modes = p.modes(3);
+  const ModalDerivatives d = p.derivatives(modes);
   ASSERT_EQ(d.pairs.size(), 6u);
   for (double r : d.residuals) EXPECT_LT(r, 1e-8);
   const Eigen::MatrixXd phi = p.dense(modes.vectors), psi = p.dense(d.vectors);
@@ -151,11 +158,8 @@ TEST_P(BakeStages, DerivativesSolveTheDenseSystem) {
 TEST_P(BakeStages, BasisIsTheDenseMassPcaAndMassOrthonormal) {
   const bool free = GetParam();
   Problem p(free);
-  ModeSettings ms;
-  ms.count = 3;
-  LinearModes modes = computeLinearModes(p.system.stiffness, p.system.mass, *p.layout, ms, p.rigid);
-  ModalDerivatives d = computeModalDerivatives(p.mesh, p.perTet, p.partition.tetPart, p.system.stiffness,
-                                               p.system.mass, *p.layout, modes, p.rigid, DerivativeSettings{});
+  const LinearModes modes = p.modes(3);
+  const ModalDerivatives d = p.derivatives(modes);
   BasisSettings bs;
   bs.rank = 5;
   ReducedBasis basis = buildBasis(p.system.mass, *p.layout, modes, d, bs);
