@@ -158,8 +158,15 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
     hashMaterials(h, perTet);
     meshHash = h.hex();
   });
-  if (ctx.rank() == 0)
+  if (ctx.rank() == 0) {
     for (const std::string& w : mesh.warnings) std::fprintf(stderr, "quiver-bake: warning: %s\n", w.c_str());
+    // A mesh without materials and a command line without all three values: say what is assumed.
+    if (mesh.mesh.materials.empty() && !(s.material.youngsModulus && s.material.poissonRatio && s.material.density))
+      std::fprintf(stderr,
+                   "quiver-bake: warning: %s defines no material; using E = %g Pa, nu = %g, density = %g kg/m^3 "
+                   "where --E, --nu, --density do not say\n",
+                   s.meshPath.c_str(), perTet[0].youngsModulus, perTet[0].poissonRatio, perTet[0].density);
+  }
   const int64_t freeDofs = 3 * (static_cast<int64_t>(mesh.mesh.vertexCount()) - static_cast<int64_t>(fixed.size()));
   const bool freeObject = fixed.empty();
   if (s.modes + (freeObject ? 6 : 0) > freeDofs || s.rank > freeDofs)

@@ -71,6 +71,7 @@ class QuiverBake(unittest.TestCase):
                 for suffix in (".h5", ".xmf", ".eigenvalues.npy", ".modes.npy", ".U.npy"):
                     self.assertTrue(os.path.exists(name + suffix), suffix)
                 self.assertFalse(os.path.exists(name + ".h5.partial"))
+                self.assertNotIn("defines no material", p.stderr)  # --E, --nu and --density all given
                 r = load(name)
                 self.assertEqual(r["modes"].shape, (3 * 204, 6))
                 self.assertEqual(r["U"].shape, (3 * 204, 12))
@@ -91,6 +92,7 @@ class QuiverBake(unittest.TestCase):
         with open(os.path.join(self.dir, "log.txt")) as log:
             self.assertIn("EPSSolve", log.read())
         self.assertNotIn("was not used", p.stderr)
+        self.assertIn("defines no material; using E = 1e+06 Pa, nu = 0.45, density = 1000", p.stderr)
         p = bake(1, self.beam, "--fix", "x<min+1e-9", "--modes", "2", "--rank", "3", "-o",
                  os.path.join(self.dir, "opts"), "-eps_tl", "1e-13")
         self.assertEqual(p.returncode, 0, p.stderr)
