@@ -96,6 +96,10 @@ int main(int argc, char** argv) {
                   "stvk (the reduced model), linear (R = K(0) q in the same subspace) or warping (linear + modal warping)")
       ->capture_default_str()
       ->check(CLI::IsMember({"stvk", "linear", "warping"}));
+  CLI::App* render = app.add_subcommand("render", "Draw MODEL.qvr to a PNG without a display (rest, pulled, or its modes)");
+  quiver::app::RenderOptions renderOptions;
+  render->add_option("model", path, "Model file (.qvr)")->required();
+  renderOptions.addTo(*render);
   CLI::App* fullSpace = app.add_subcommand("full", "Run the same scenarios on the full-space StVK reference simulator");
   quiver::app::MeshOptions fullMesh;
   quiver::app::FixedVertexOptions fullFixed;
@@ -128,6 +132,7 @@ int main(int argc, char** argv) {
       return quiver::app::simulateFullSpace(mesh.mesh, mesh.fileVertex, mesh.loadedVertex.size(), fixed, fullOptions,
                                             fullSim);
     }
+    if (*render) return quiver::app::renderModel(path, renderOptions);
     if (*sim) return quiver::app::simulateModel(path, integrator, elasticity, simOptions);
     ModelHandle model(path);
     qv_model_info mi;

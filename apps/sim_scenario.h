@@ -77,4 +77,19 @@ struct FullSpaceOptions {
 int simulateFullSpace(const TetMesh& mesh, const std::vector<int>& fileVertex, size_t fileVertexCount,
                       const std::vector<int>& fixed, const FullSpaceOptions& full, const SimOptions& options);
 
+struct RenderOptions {
+  std::string output;                  // PNG path
+  std::vector<int> size{800, 500};     // pixels
+  int modes = 0;                       // > 0: a grid of the first `modes` basis vectors
+  double amplitude = 0.1;              // grid: largest displacement, fraction of the model's diagonal
+  std::vector<double> pull{0, 0, 0};   // N: pull the group for `steps` steps before drawing
+  std::string group = "x>max-1e-6";
+  int steps = 120;
+
+  void addTo(CLI::App& app);
+};
+
+// `quiver render MODEL.qvr`: returns the exit code.
+int renderModel(const std::string& modelPath, const RenderOptions& options);
+
 } // namespace quiver::app

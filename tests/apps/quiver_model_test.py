@@ -164,5 +164,44 @@ class QuiverSim(unittest.TestCase):
             self.assertIn(message, p.stderr)
 
 
+class QuiverRender(unittest.TestCase):
+    """`quiver render` without a display: the pictures decode, show the model, and show it moving."""
+
+    @classmethod
+    def setUpClass(cls):
+        QuiverModel.setUpClass()
+        cls.model = QuiverModel.full + ".qvr"
+        cls.tmp = QuiverModel.tmp
+
+    def picture(self, name, *args):
+        path = os.path.join(self.tmp.name, name)
+        p = subprocess.run([QUIVER, "render", self.model, "-o", path, *map(str, args)], capture_output=True, text=True,
+                           timeout=120)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        try:
+            import matplotlib.image
+        except ImportError:
+            self.skipTest("python3-matplotlib not installed: cannot decode the PNG")
+        return matplotlib.image.imread(path)[:, :, :3]
+
+    def test_rest_pulled_and_modes(self):
+        rest = self.picture("rest.png", "--size", "320,200")
+        self.assertEqual(rest.shape, (200, 320, 3))
+        covered = (rest < 0.99).any(axis=2).mean()
+        self.assertGreater(covered, 0.02)  # not blank
+        self.assertLess(covered, 0.9)  # and not all model: the camera frames it
+        self.assertGreater(len(np.unique(rest.reshape(-1, 3), axis=0)), 3)  # shaded faces, not one flat colour
+        pulled = self.picture("pulled.png", "--size", "320,200", "--pull", "0,0,-20", "--steps", "90")
+        self.assertGreater((np.abs(pulled - rest).max(axis=2) > 0.05).mean(), 0.005)  # it moved
+        modes = self.picture("modes.png", "--size", "300,300", "--modes", "4")
+        self.assertGreater((modes < 0.99).any(axis=2).mean(), 0.02)
+
+    def test_bad_options(self):
+        p = subprocess.run([QUIVER, "render", self.model, "-o", os.path.join(self.tmp.name, "x.png"), "--size", "4,4"],
+                           capture_output=True, text=True)
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn("--size", p.stderr)
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)
