@@ -112,14 +112,19 @@ class QuiverModel(unittest.TestCase):
         self.assertIn("none.qvr: cannot open", p.stderr)
 
 
-class QuiverSim(unittest.TestCase):
-    """`quiver sim` as a user runs it: the files it promises, readable by an independent reader."""
+class OnTheBakedModel(unittest.TestCase):
+    """Shares QuiverModel's baked beam, so the bake runs once per file."""
 
     @classmethod
     def setUpClass(cls):
-        QuiverModel.setUpClass()
+        if not hasattr(QuiverModel, "full"):
+            QuiverModel.setUpClass()
         cls.model = QuiverModel.full + ".qvr"
         cls.tmp = QuiverModel.tmp
+
+
+class QuiverSim(OnTheBakedModel):
+    """`quiver sim` as a user runs it: the files it promises, readable by an independent reader."""
 
     def sim(self, *args, ok=True):
         p = subprocess.run([QUIVER, "sim", self.model, *map(str, args)], capture_output=True, text=True, timeout=120)
@@ -164,14 +169,8 @@ class QuiverSim(unittest.TestCase):
             self.assertIn(message, p.stderr)
 
 
-class QuiverRender(unittest.TestCase):
+class QuiverRender(OnTheBakedModel):
     """`quiver render` without a display: the pictures decode, show the model, and show it moving."""
-
-    @classmethod
-    def setUpClass(cls):
-        QuiverModel.setUpClass()
-        cls.model = QuiverModel.full + ".qvr"
-        cls.tmp = QuiverModel.tmp
 
     def picture(self, name, *args):
         path = os.path.join(self.tmp.name, name)
