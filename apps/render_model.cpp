@@ -1,6 +1,7 @@
 // `quiver render`: headless pictures of a model, drawn by the software rasterizer: the rest shape,
 // the shape after pulling a vertex group for some steps, or a grid of the first basis vectors.
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "apps/render/software_renderer.h"
@@ -102,10 +103,15 @@ int renderModel(const std::string& path, const RenderOptions& o) {
       const std::vector<int> group = VertexSelector(o.group).select(points);
       if (group.empty()) throw std::runtime_error("--group '" + o.group + "' selects no vertex");
       const double share[3] = {o.pull[0] / group.size(), o.pull[1] / group.size(), o.pull[2] / group.size()};
+      int resets = 0;
       for (int step = 0; step < o.steps; ++step) {
         for (int v : group) qv_instance_add_vertex_force(m.instance, v, share);
-        qv_instance_step(m.instance);
+        resets += qv_instance_step(m.instance) == QV_STEP_RESET;
       }
+      // The runtime resets a diverged state to rest; say so rather than draw a rest shape as "pulled".
+      if (resets > 0)
+        std::fprintf(stderr, "quiver render: warning: the pull diverged and the model was reset to rest %d times; "
+                             "try a smaller --pull\n", resets);
     }
     drawTriangles(image, camera(m.info, width, height, 0.15), m.positions(), triangles, kSteel);
   }

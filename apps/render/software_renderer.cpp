@@ -69,6 +69,11 @@ void drawTriangles(Image& image, const Camera& camera, const std::vector<float>&
       p[k] = Eigen::Vector3d(image.width / 2.0 + camera.scale * q.x(), image.height / 2.0 - camera.scale * q.y(),
                              camera.scale * q.z());
     }
+    // A diverged simulation gives huge or NaN positions; casting those to int below would be undefined.
+    const auto onCanvas = [&](const Eigen::Vector3d& v) {
+      return v.allFinite() && std::abs(v.x()) < 1e6 && std::abs(v.y()) < 1e6;
+    };
+    if (!onCanvas(p[0]) || !onCanvas(p[1]) || !onCanvas(p[2])) continue;
     // Shade by the camera-space normal (both sides lit, so open or inverted surfaces still show).
     Eigen::Vector3d e1(p[1].x() - p[0].x(), -(p[1].y() - p[0].y()), p[1].z() - p[0].z());
     Eigen::Vector3d e2(p[2].x() - p[0].x(), -(p[2].y() - p[0].y()), p[2].z() - p[0].z());

@@ -200,6 +200,10 @@ class QuiverRender(OnTheBakedModel):
                            capture_output=True, text=True)
         self.assertNotEqual(p.returncode, 0)
         self.assertIn("--size", p.stderr)
+        p = subprocess.run([QUIVER, "render", self.model, "-o", os.path.join(self.tmp.name, "blown.png"), "--pull", "0,0,-1e9",
+                            "--steps", "3"], capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)  # still a picture, but the user is told it is not the pull
+        self.assertIn("reset to rest", p.stderr)
 
 
 if __name__ == "__main__":
