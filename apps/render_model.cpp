@@ -6,7 +6,6 @@
 
 #include "apps/render/software_renderer.h"
 #include "apps/sim_scenario.h"
-#include "common/vertex_selector.h"
 #include "quiver/quiver.h"
 
 namespace quiver::app {
@@ -100,8 +99,7 @@ int renderModel(const std::string& path, const RenderOptions& o) {
       const double* rest = qv_model_rest_positions(m.model);
       TetMesh points;
       for (int v = 0; v < m.info.vertex_count; ++v) points.vertices.emplace_back(rest[3 * v], rest[3 * v + 1], rest[3 * v + 2]);
-      const std::vector<int> group = VertexSelector(o.group).select(points);
-      if (group.empty()) throw std::runtime_error("--group '" + o.group + "' selects no vertex");
+      const std::vector<int> group = selectGroup(points, o.group);
       const double share[3] = {o.pull[0] / group.size(), o.pull[1] / group.size(), o.pull[2] / group.size()};
       int resets = 0;
       for (int step = 0; step < o.steps; ++step) {

@@ -41,14 +41,19 @@ double percentile(std::vector<double> values, double p) {
   return values.empty() ? 0 : values[std::min(values.size() - 1, static_cast<size_t>(p * (values.size() - 1) + 0.5))];
 }
 
-ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const SimOptions& o) {
+std::vector<int> selectGroup(const TetMesh& mesh, const std::string& selector) {
   std::vector<int> group;
   try {
-    group = VertexSelector(o.group).select(mesh);
+    group = VertexSelector(selector).select(mesh);
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(std::string("--group: ") + e.what());
   }
-  if (group.empty()) throw std::runtime_error("--group '" + o.group + "' selects no vertex");
+  if (group.empty()) throw std::runtime_error("--group '" + selector + "' selects no vertex");
+  return group;
+}
+
+ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const SimOptions& o) {
+  const std::vector<int> group = selectGroup(mesh, o.group);
   const bool dragMode = o.twist != 0 || o.drag != std::vector<double>{0, 0, 0};
   if (o.gravity) {
     const double g[3] = {0, 0, -9.81};

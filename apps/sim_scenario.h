@@ -53,6 +53,9 @@ struct ScenarioResult {
   int failedSteps = 0;  // resets (runtime) — the scenario goes on
 };
 
+// The vertices of `mesh` that the --group `selector` picks; throws naming --group if it is malformed or picks none.
+std::vector<int> selectGroup(const TetMesh& mesh, const std::string& selector);
+
 // Runs the scenario on `target` over `mesh` (rest shape, and tets for the .vtu frames).
 ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const SimOptions& options);
 

@@ -200,6 +200,12 @@ class QuiverRender(OnTheBakedModel):
                            capture_output=True, text=True)
         self.assertNotEqual(p.returncode, 0)
         self.assertIn("--size", p.stderr)
+        for group, message in (("q<1", "--group"), ("x<-5", "selects no vertex")):
+            p = subprocess.run([QUIVER, "render", self.model, "-o", os.path.join(self.tmp.name, "x.png"), "--pull", "0,0,-1",
+                                "--group", group], capture_output=True, text=True)
+            self.assertNotEqual(p.returncode, 0)
+            self.assertIn(message, p.stderr)
+            self.assertFalse(os.path.exists(os.path.join(self.tmp.name, "x.png")))
         p = subprocess.run([QUIVER, "render", self.model, "-o", os.path.join(self.tmp.name, "blown.png"), "--pull", "0,0,-1e9",
                             "--steps", "3"], capture_output=True, text=True)
         self.assertEqual(p.returncode, 0, p.stderr)  # still a picture, but the user is told it is not the pull
