@@ -1,6 +1,5 @@
 // quiver: inspect and evaluate baked runtime models (.qvr). Built on the runtime library alone:
 // what it prints is what a game embedding the runtime would compute.
-#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <vector>
@@ -10,6 +9,7 @@
 
 #include "apps/sim_scenario.h"
 #include "apps/support/mesh_options.h"
+#include "formats/mesh/read_mesh.h"
 #include "formats/model/qvr.h"
 #include "formats/npy.h"
 #include "quiver/quiver.h"
@@ -30,8 +30,7 @@ struct ModelHandle {
 
 // Section names and sizes straight from the file's table (already validated by the loader).
 ordered_json sectionSizes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string bytes = quiver::readFileBytes(path);
   auto u32 = [&](size_t at) { uint32_t v; std::memcpy(&v, &bytes[at], 4); return v; };
   auto u64 = [&](size_t at) { uint64_t v; std::memcpy(&v, &bytes[at], 8); return v; };
   static const char* names[] = {"", "MODEL_INFO", "ENERGY_COEFFICIENTS", "BASIS", "REST_POSITIONS",
@@ -120,12 +119,7 @@ int main(int argc, char** argv) {
   fullSpace->add_option("--nu", fullOptions.material.poissonRatio, "Poisson ratio; overrides the mesh file's");
   fullSpace->add_option("--density", fullOptions.material.density, "Density in kg/m^3; overrides the mesh file's");
   fullSpace->add_option("--final-npy", fullOptions.finalNpy, "Save the final displacement (3N, file vertex order) as .npy");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
-  try {
+  return quiver::app::runTool("quiver", app, argc, argv, [&] {
     if (*fullSpace) {
       quiver::CheckedMesh mesh = fullMesh.load("quiver");
       const std::vector<int> fixed = fullFixed.select(mesh);
@@ -171,9 +165,6 @@ int main(int argc, char** argv) {
     }
     // Full precision: every double printed reads back exactly (nlohmann prints shortest round-trip form).
     std::cout << out.dump(1) << "\n";
-  } catch (const std::exception& e) {
-    std::cerr << "quiver: error: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+    return 0;
+  });
 }
