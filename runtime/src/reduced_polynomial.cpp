@@ -114,7 +114,7 @@ size_t ReducedPolynomial::storageBytes(int r, bool single) {
          2 * roundUp64(pairs * sizeof(size_t)) + roundUp64(packedCount(pairs) * (single ? sizeof(float) : sizeof(double)));
 }
 
-size_t ReducedPolynomial::scratchSize(int r) { return monomialCount2(r) * 5 + static_cast<size_t>(r); }
+size_t ReducedPolynomial::scratchSize(int r) { return monomialCount2(r) * 3 + static_cast<size_t>(r); }
 
 void ReducedPolynomial::build(int r, const double* c, bool single, void* storage) {
   r_ = r;
@@ -195,9 +195,7 @@ void ReducedPolynomial::evaluate(const double* q, double* energy, double* force,
   double* x = scratch;       // w_kl q_k q_l
   double* y3 = x + P;        // K_3(q) per pair
   double* y4 = y3 + P;       // K_4(q) per pair
-  double* F = y4 + P;        // K_2 + K_3/2 + K_4/3, per pair
-  double* H = F + P;         // K_2/2 + K_3/6 + K_4/12, per pair
-  double* Rq = H + P;        // r
+  double* Rq = y4 + P;       // r
   for (int k = 0, s = 0; k < r; ++k)
     for (int l = k; l < r; ++l) x[s++] = (k == l ? 0.5 : 1.0) * q[k] * q[l];
   if (q32_)
@@ -211,11 +209,10 @@ void ReducedPolynomial::evaluate(const double* q, double* energy, double* force,
     for (int b = a; b < r; ++b, ++p) {
       const double k2 = k2_[p], s3 = y3[p], s4 = y4[p];
       if (stiffness) stiffness[a * r + b] = stiffness[b * r + a] = k2 + s3 + s4;
-      F[p] = k2 + s3 / 2 + s4 / 3;
-      H[p] = k2 / 2 + s3 / 6 + s4 / 12;
-      Rq[a] += F[p] * q[b];
-      if (b != a) Rq[b] += F[p] * q[a];
-      e += (a == b ? 1.0 : 2.0) * H[p] * q[a] * q[b];
+      const double f = k2 + s3 / 2 + s4 / 3, h = k2 / 2 + s3 / 6 + s4 / 12;
+      Rq[a] += f * q[b];
+      if (b != a) Rq[b] += f * q[a];
+      e += (a == b ? 1.0 : 2.0) * h * q[a] * q[b];
     }
   if (force)
     for (int i = 0; i < r; ++i) force[i] = Rq[i];
