@@ -59,8 +59,7 @@ int main(int argc, char** argv) {
   std::string error;
   try {
     checkBakeSettings(s);  // before any work
-    if (!fixedOptions.indexList.empty()) fixedOptions.request.indices = parseIndexList(fixedOptions.indexList, "--fix-indices");
-    s.fixed = fixedOptions.request;
+    s.fixed = fixedOptions.resolved();
     runBake(ctx, s);
   } catch (const std::exception& e) {
     error = e.what();

@@ -92,9 +92,8 @@ int main(int argc, char** argv) {
     if (*info) {
       CheckedMesh m = infoMesh.load(tool);
       std::vector<int> fixed;
-      if (!infoFixed.request.empty() || !infoFixed.indexList.empty()) fixed = infoFixed.select(m);
-      bool withFixed = !infoFixed.request.empty() || !infoFixed.indexList.empty();
-      std::cout << describe(infoMesh.path, m, withFixed ? &fixed : nullptr).dump(2) << "\n";
+      if (infoFixed.given()) fixed = infoFixed.select(m);
+      std::cout << describe(infoMesh.path, m, infoFixed.given() ? &fixed : nullptr).dump(2) << "\n";
     } else if (*convert) {
       writeMeshFile(convertOut, convertMesh.load(tool).mesh);
     } else if (*beam) {

@@ -30,10 +30,13 @@ void FixedVertexOptions::addTo(CLI::App& app) {
       ->check(CLI::ExistingFile);
 }
 
-std::vector<int> FixedVertexOptions::select(const CheckedMesh& mesh) {
-  if (!indexList.empty()) request.indices = parseIndexList(indexList, "--fix-indices");
-  return selectFixedVertices(mesh, request);
+FixedVertexRequest FixedVertexOptions::resolved() const {
+  FixedVertexRequest r = request;
+  if (!indexList.empty()) r.indices = parseIndexList(indexList, "--fix-indices");
+  return r;
 }
+
+std::vector<int> FixedVertexOptions::select(const CheckedMesh& mesh) const { return selectFixedVertices(mesh, resolved()); }
 
 int runTool(const std::string& tool, CLI::App& app, int argc, char** argv, const std::function<int()>& body) {
   try {

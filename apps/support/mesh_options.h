@@ -26,7 +26,10 @@ struct FixedVertexOptions {
 
   // Adds --fix EXPR (repeatable), --fix-indices LIST and --bou FILE (repeatable).
   void addTo(CLI::App& app);
-  std::vector<int> select(const CheckedMesh& mesh);
+  bool given() const { return !request.empty() || !indexList.empty(); }
+  // The request with --fix-indices parsed in; throws naming --fix-indices if the list is malformed.
+  FixedVertexRequest resolved() const;
+  std::vector<int> select(const CheckedMesh& mesh) const;
 };
 
 // Runs `body`, turning any exception into "TOOL: error: message" on stderr and exit code 1.
