@@ -9,6 +9,8 @@
 
 #include "apps/sim_scenario.h"
 #include "apps/support/mesh_options.h"
+#include "apps/support/reduced_modes.h"
+#include "apps/support/runtime_model.h"
 #include "formats/mesh/read_mesh.h"
 #include "formats/model/qvr.h"
 #include "formats/npy.h"
@@ -17,16 +19,6 @@
 using nlohmann::ordered_json;
 
 namespace {
-
-struct ModelHandle {
-  qv_model* model = nullptr;
-  explicit ModelHandle(const std::string& path) {
-    char message[1024] = "";
-    if (qv_model_load_file(path.c_str(), nullptr, nullptr, &model, message, sizeof message) != QV_OK)
-      throw std::runtime_error(message);
-  }
-  ~ModelHandle() { qv_model_destroy(model); }
-};
 
 // Section names and sizes straight from the file's table (already validated by the loader).
 ordered_json sectionSizes(const std::string& path) {
@@ -95,7 +87,7 @@ int main(int argc, char** argv) {
                   "stvk (the reduced model), linear (R = K(0) q in the same subspace) or warping (linear + modal warping)")
       ->capture_default_str()
       ->check(CLI::IsMember({"stvk", "linear", "warping"}));
-  CLI::App* render = app.add_subcommand("render", "Draw MODEL.qvr to a PNG without a display (rest, pulled, or its modes)");
+  CLI::App* render = app.add_subcommand("render", "Draw MODEL.qvr without a display: rest, after (or during) a scenario, or its modes; PNG, GIF or image sequence");
   quiver::app::RenderOptions renderOptions;
   render->add_option("model", path, "Model file (.qvr)")->required();
   renderOptions.addTo(*render);
@@ -128,9 +120,8 @@ int main(int argc, char** argv) {
     }
     if (*render) return quiver::app::renderModel(path, renderOptions);
     if (*sim) return quiver::app::simulateModel(path, integrator, elasticity, simOptions);
-    ModelHandle model(path);
-    qv_model_info mi;
-    qv_model_get_info(model.model, &mi);
+    const quiver::app::RuntimeModel model(path);
+    const qv_model_info& mi = model.info();
     ordered_json out;
     if (*info) {
       out["r"] = mi.r;
@@ -142,8 +133,13 @@ int main(int argc, char** argv) {
       out["sections"] = sectionSizes(path);
       std::vector<double> hz;
       for (int i = 0; i < mi.eigenvalue_count; ++i)
-        hz.push_back(std::sqrt(std::max(qv_model_eigenvalues(model.model)[i], 0.0)) / (2 * M_PI));
+        hz.push_back(std::sqrt(std::max(qv_model_eigenvalues(model.get())[i], 0.0)) / (2 * M_PI));
       out["frequencies_hz"] = hz;
+      // The same modes as the reduced model has them (K~(0) in span U): how well the basis holds the baked modes.
+      hz.clear();
+      for (double lambda : quiver::app::reducedModes(model.get()).eigenvalues)
+        hz.push_back(std::sqrt(std::max(lambda, 0.0)) / (2 * M_PI));
+      out["reduced_frequencies_hz"] = hz;
       out["material"] = {{"youngs_modulus", mi.youngs_modulus}, {"poisson_ratio", mi.poisson_ratio},
                          {"density", mi.density}, {"uniform", mi.material_is_uniform != 0}};
       out["total_mass"] = mi.total_mass;
@@ -153,10 +149,10 @@ int main(int argc, char** argv) {
                      {"max", {mi.bbox_max[0], mi.bbox_max[1], mi.bbox_max[2]}}};
     } else {
       const std::vector<double> q = parseQ(qText, mi.r);
-      std::vector<double> scratch(qv_model_scratch_size(model.model) / sizeof(double) + 1), force(mi.r),
+      std::vector<double> scratch(qv_model_scratch_size(model.get()) / sizeof(double) + 1), force(mi.r),
           stiffness(static_cast<size_t>(mi.r) * mi.r);
       double energy = 0;
-      qv_model_evaluate(model.model, q.data(), &energy, force.data(), stiffness.data(), scratch.data());
+      qv_model_evaluate(model.get(), q.data(), &energy, force.data(), stiffness.data(), scratch.data());
       out["energy"] = energy;
       out["force"] = force;
       std::vector<std::vector<double>> rows;

@@ -15,7 +15,7 @@
 
 namespace quiver::app {
 
-void SimOptions::addTo(CLI::App& app) {
+void SimOptions::addScenarioTo(CLI::App& app) {
   app.add_option("--steps", steps, "Steps to simulate")->capture_default_str()->check(CLI::PositiveNumber);
   app.add_option("--hold", holdSteps, "Steps the load acts before it is released")->capture_default_str();
   app.add_option("--group", group, "Loaded vertices, a selector such as \"x>max-1e-6\" (mesh units)")->capture_default_str();
@@ -31,9 +31,18 @@ void SimOptions::addTo(CLI::App& app) {
   app.add_option("--newton", newton, "Newton iterations per implicit step (full space: the most)")->capture_default_str();
   app.add_option("--alpha", alpha, "Mass-proportional damping, 1/s");
   app.add_option("--beta", beta, "Stiffness-proportional damping, s");
+}
+
+void SimOptions::addTo(CLI::App& app) {
+  addScenarioTo(app);
   app.add_option("-o,--output", output, "Write NAME.pvd with NAME_NNNNN.vtu frames and NAME.csv");
   app.add_option("--every", every, "Write every k-th step")->capture_default_str()->check(CLI::PositiveNumber);
   app.add_flag("--json", json, "Print one JSON summary");
+}
+
+bool SimOptions::hasLoad() const {
+  const std::vector<double> none{0, 0, 0};
+  return force != none || drag != none || twist != 0 || gravity;
 }
 
 double percentile(std::vector<double> values, double p) {
@@ -52,7 +61,8 @@ std::vector<int> selectGroup(const TetMesh& mesh, const std::string& selector) {
   return group;
 }
 
-ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const SimOptions& o) {
+ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const SimOptions& o,
+                           const std::function<void(int)>& afterStep) {
   const std::vector<int> group = selectGroup(mesh, o.group);
   const bool dragMode = o.twist != 0 || o.drag != std::vector<double>{0, 0, 0};
   if (o.gravity) {
@@ -98,6 +108,7 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
     target.energies(kinetic, elastic);
     csv << step + 1 << "," << (step + 1) * h << "," << kinetic << "," << elastic << "," << result.stepMicros.back() << ","
         << newton << "," << status << "\n";
+    if (afterStep) afterStep(step + 1);
     if (!o.output.empty() && (step + 1) % o.every == 0) {
       target.displacement(u);
       PointField field{"displacement", {}};

@@ -3,6 +3,7 @@
 // reference on a mesh): pull a vertex group with a force, or drag and twist it with penalty springs,
 // for some steps, release, optionally under gravity; write what happens. One script drives both,
 // so their outputs compare like for like.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -29,7 +30,11 @@ struct SimOptions {
   int every = 1;                        // write every k-th step
   bool json = false;                    // print one JSON summary instead of text
 
+  // The scenario: loads, their timing, the integrator's settings (shared by sim, full and render).
+  void addScenarioTo(CLI::App& app);
+  // The scenario and what `sim` and `full` write: -o, --every, --json.
   void addTo(CLI::App& app);
+  bool hasLoad() const;
 };
 
 // What a scenario drives: the runtime's instance or the full-space simulator.
@@ -56,8 +61,10 @@ struct ScenarioResult {
 // The vertices of `mesh` that the --group `selector` picks; throws naming --group if it is malformed or picks none.
 std::vector<int> selectGroup(const TetMesh& mesh, const std::string& selector);
 
-// Runs the scenario on `target` over `mesh` (rest shape, and tets for the .vtu frames).
-ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const SimOptions& options);
+// Runs the scenario on `target` over `mesh` (rest shape, and tets for the .vtu frames), calling
+// `afterStep` (if given) with the number of steps taken so far after each one.
+ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const SimOptions& options,
+                           const std::function<void(int)>& afterStep = {});
 
 // Median and 99th percentile of step times, in microseconds.
 double percentile(std::vector<double> values, double p);
@@ -81,13 +88,13 @@ int simulateFullSpace(const TetMesh& mesh, const std::vector<int>& fileVertex, s
                       const std::vector<int>& fixed, const FullSpaceOptions& full, const SimOptions& options);
 
 struct RenderOptions {
-  std::string output;                  // PNG path
+  std::string output;                  // NAME.png, NAME.gif or NAME_%04d.png (apps/render/frame_writer.h)
   std::vector<int> size{800, 500};     // pixels
-  int modes = 0;                       // > 0: a grid of the first `modes` basis vectors
+  int modes = 0;                       // > 0: a grid of the first `modes` linear modes
+  bool basis = false;                  // the grid shows basis vectors (columns of U) instead
   double amplitude = 0.1;              // grid: largest displacement, fraction of the model's diagonal
-  std::vector<double> pull{0, 0, 0};   // N: pull the group for `steps` steps before drawing
-  std::string group = "x>max-1e-6";
-  int steps = 120;
+  int every = 2;                       // animated scenario: a frame every k-th step
+  SimOptions scenario;                 // what happens before (or while) the model is drawn
 
   void addTo(CLI::App& app);
 };

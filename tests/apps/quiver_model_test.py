@@ -57,6 +57,15 @@ class QuiverModel(unittest.TestCase):
         self.assertLess(j["sections"]["ENERGY_COEFFICIENTS"], vega)
         self.assertEqual(j["sections"]["BASIS"], 4 * 3 * j["vertices"] * r)  # float32 by default
         np.testing.assert_allclose(j["frequencies_hz"], np.sqrt(self.eigenvalues) / (2 * np.pi), rtol=1e-12)
+        # The modes as the reduced model has them (its own K~(0) in span U) are Rayleigh-Ritz approximations of
+        # the ones SLEPc baked: never below them; the first, which the basis weighs most, close.
+        reduced = np.array(j["reduced_frequencies_hz"])
+        self.assertEqual(len(reduced), r)
+        self.assertTrue(np.all(reduced[:6] >= np.array(j["frequencies_hz"]) * (1 - 1e-9)))
+        self.assertLess(reduced[0] / j["frequencies_hz"][0] - 1, 1e-3)
+        # A basis of exactly the modes holds them exactly.
+        modal = quiver("info", self.modal + ".qvr")
+        np.testing.assert_allclose(modal["reduced_frequencies_hz"], modal["frequencies_hz"], rtol=1e-9)
         self.assertAlmostEqual(j["total_mass"], 1000 * 1 * 0.1 * 0.15, places=9)
         self.assertEqual(j["material"]["poisson_ratio"], 0.4)
 
@@ -172,44 +181,85 @@ class QuiverSim(OnTheBakedModel):
 class QuiverRender(OnTheBakedModel):
     """`quiver render` without a display: the pictures decode, show the model, and show it moving."""
 
-    def picture(self, name, *args):
+    def render(self, name, *args, ok=True):
         path = os.path.join(self.tmp.name, name)
         p = subprocess.run([QUIVER, "render", self.model, "-o", path, *map(str, args)], capture_output=True, text=True,
                            timeout=120)
-        self.assertEqual(p.returncode, 0, p.stderr)
+        if ok:
+            self.assertEqual(p.returncode, 0, p.stderr)
+        return path, p
+
+    def picture(self, name, *args):
         try:
             import matplotlib.image
         except ImportError:
             self.skipTest("python3-matplotlib not installed: cannot decode the PNG")
-        return matplotlib.image.imread(path)[:, :, :3]
+        return matplotlib.image.imread(self.render(name, *args)[0])[:, :, :3]
+
+    def frames(self, name, *args):
+        try:
+            from PIL import Image, ImageSequence
+        except ImportError:
+            self.skipTest("python3-pil not installed: cannot decode the GIF")
+        with Image.open(self.render(name, *args)[0]) as gif:
+            self.assertEqual(gif.info.get("loop"), 0)  # loops forever
+            return [np.asarray(f.convert("RGB"), dtype=float) / 255 for f in ImageSequence.Iterator(gif)], gif.info
+
+    def assertFramed(self, image):
+        covered = (image < 0.99).any(axis=2).mean()
+        self.assertGreater(covered, 0.02)  # not blank
+        self.assertLess(covered, 0.9)  # and not all model: the camera frames it
+
+    def assertMoved(self, a, b):
+        self.assertGreater((np.abs(a - b).max(axis=2) > 0.05).mean(), 0.005)
 
     def test_rest_pulled_and_modes(self):
         rest = self.picture("rest.png", "--size", "320,200")
         self.assertEqual(rest.shape, (200, 320, 3))
-        covered = (rest < 0.99).any(axis=2).mean()
-        self.assertGreater(covered, 0.02)  # not blank
-        self.assertLess(covered, 0.9)  # and not all model: the camera frames it
+        self.assertFramed(rest)
         self.assertGreater(len(np.unique(rest.reshape(-1, 3), axis=0)), 3)  # shaded faces, not one flat colour
-        pulled = self.picture("pulled.png", "--size", "320,200", "--pull", "0,0,-20", "--steps", "90")
-        self.assertGreater((np.abs(pulled - rest).max(axis=2) > 0.05).mean(), 0.005)  # it moved
+        pulled = self.picture("pulled.png", "--size", "320,200", "--force", "0,0,-20", "--hold", "90", "--steps", "90")
+        self.assertMoved(pulled, rest)
+        twisted = self.picture("twisted.png", "--size", "320,200", "--twist", "40", "--hold", "60", "--steps", "60")
+        self.assertMoved(twisted, rest)
+        self.assertMoved(twisted, pulled)
         modes = self.picture("modes.png", "--size", "300,300", "--modes", "4")
-        self.assertGreater((modes < 0.99).any(axis=2).mean(), 0.02)
+        self.assertFramed(modes)
+        basis = self.picture("basis.png", "--size", "300,300", "--modes", "4", "--basis")
+        self.assertFramed(basis)
+        # The first linear mode is the first basis vector's largest part, not all of it: the tiles differ.
+        self.assertMoved(modes, basis)
+
+    def test_animations(self):
+        frames, info = self.frames("pull.gif", "--size", "160,100", "--force", "0,0,-20", "--hold", "20", "--steps",
+                                   "40", "--every", "4")
+        self.assertEqual(len(frames), 1 + 40 // 4)  # the rest pose, then every 4th step
+        self.assertEqual(frames[0].shape, (100, 160, 3))
+        self.assertFramed(frames[0])
+        self.assertMoved(frames[5], frames[0])  # pulled at step 20
+        modes, _ = self.frames("modes.gif", "--size", "200,200", "--modes", "4")
+        self.assertEqual(len(modes), 30)  # one oscillation
+        self.assertMoved(modes[7], modes[0])  # a quarter period: at full amplitude, from rest
+        sequence = os.path.join(self.tmp.name, "seq")
+        os.makedirs(sequence)
+        self.render(os.path.join(sequence, "f_%03d.png"), "--size", "64,48", "--gravity", "--steps", "6", "--every", "3")
+        self.assertEqual(sorted(os.listdir(sequence)), ["f_000.png", "f_001.png", "f_002.png"])
 
     def test_bad_options(self):
-        p = subprocess.run([QUIVER, "render", self.model, "-o", os.path.join(self.tmp.name, "x.png"), "--size", "4,4"],
-                           capture_output=True, text=True)
-        self.assertNotEqual(p.returncode, 0)
-        self.assertIn("--size", p.stderr)
-        for group, message in (("q<1", "--group"), ("x<-5", "selects no vertex")):
-            p = subprocess.run([QUIVER, "render", self.model, "-o", os.path.join(self.tmp.name, "x.png"), "--pull", "0,0,-1",
-                                "--group", group], capture_output=True, text=True)
-            self.assertNotEqual(p.returncode, 0)
-            self.assertIn(message, p.stderr)
-            self.assertFalse(os.path.exists(os.path.join(self.tmp.name, "x.png")))
-        p = subprocess.run([QUIVER, "render", self.model, "-o", os.path.join(self.tmp.name, "blown.png"), "--pull", "0,0,-1e9",
-                            "--steps", "3"], capture_output=True, text=True)
-        self.assertEqual(p.returncode, 0, p.stderr)  # still a picture, but the user is told it is not the pull
-        self.assertIn("reset to rest", p.stderr)
+        for name, args, message in (("x.png", ["--size", "4,4"], "--size"),
+                                    ("x.png", ["--force", "0,0,-1", "--group", "q<1"], "--group"),
+                                    ("x.png", ["--force", "0,0,-1", "--group", "x<-5"], "selects no vertex"),
+                                    ("x.png", ["--modes", "3", "--gravity"], "drop the scenario"),
+                                    ("x.jpg", ["--modes", "3"], ".gif animation"),
+                                    ("x_%d_%d.png", [], "one %d-style field"),
+                                    ("x.gif", [], "nothing moves")):
+            with self.subTest(args=args):
+                _, p = self.render(name, *args, ok=False)
+                self.assertNotEqual(p.returncode, 0)
+                self.assertIn(message, p.stderr)
+                self.assertEqual([f for f in os.listdir(self.tmp.name) if f.startswith("x")], [])
+        _, p = self.render("blown.png", "--force", "0,0,-1e9", "--hold", "3", "--steps", "3")
+        self.assertIn("reset to rest", p.stderr)  # still a picture, but the user is told it is not the load
 
 
 if __name__ == "__main__":

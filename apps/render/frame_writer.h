@@ -1,0 +1,40 @@
+#pragma once
+// Where `quiver render` puts its pictures, chosen by the output path:
+//   NAME.png         one picture (the last frame given)
+//   NAME_%04d.png    an image sequence, one file per frame (printf-style number, from 0)
+//   NAME.gif         an animated GIF, looping, played back at the simulation's own speed
+// Every file is written atomically; a GIF appears only once it is complete.
+#include <memory>
+#include <string>
+
+#include "apps/render/software_renderer.h"
+
+namespace quiver::app {
+
+class FrameWriter {
+public:
+  // `frameSeconds`: the time a frame stands for, which sets the GIF's frame delay (GIF counts in
+  // hundredths of a second, and browsers slow anything under 0.02 s, so the delay is at least that).
+  // Throws if the path's kind cannot be told (a pattern must hold exactly one %d-style field and end in .png).
+  FrameWriter(const std::string& path, double frameSeconds);
+  ~FrameWriter();
+  FrameWriter(const FrameWriter&) = delete;
+  FrameWriter& operator=(const FrameWriter&) = delete;
+
+  // True when every frame is kept (sequence or GIF); a single picture only needs the last one.
+  bool animated() const;
+  void add(const Image& frame);
+  // Writes what is pending (the picture or the GIF); returns the number of frames written.
+  int finish();
+
+private:
+  struct Gif;
+  enum class Kind { Picture, Sequence, Gif } kind_;
+  std::string path_;
+  int centiseconds_;
+  int frames_ = 0;
+  std::unique_ptr<Image> last_;
+  std::unique_ptr<Gif> gif_;
+};
+
+} // namespace quiver::app

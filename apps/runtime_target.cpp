@@ -1,0 +1,67 @@
+#include "apps/runtime_target.h"
+
+#include <iostream>
+
+namespace quiver::app {
+
+namespace {
+
+qv_instance_config simulationConfig(const RuntimeModel& model, const std::string& integrator,
+                                    const std::string& elasticity, const SimOptions& o) {
+  qv_instance_config config;
+  qv_instance_config_init(&config, model.get());
+  config.integrator = integrator == "euler"     ? QV_INTEGRATOR_BACKWARD_EULER
+                      : integrator == "central" ? QV_INTEGRATOR_CENTRAL_DIFFERENCES
+                                                : QV_INTEGRATOR_IMPLICIT_NEWMARK;
+  if (o.timeStep > 0) config.time_step = o.timeStep;
+  config.newton_iterations = o.newton;
+  config.linear = elasticity == "linear";
+  config.warping = elasticity == "warping";
+  if (o.alpha >= 0) config.rayleigh_alpha = o.alpha;
+  if (o.beta >= 0) config.rayleigh_beta = o.beta;
+  return config;
+}
+
+} // namespace
+
+RuntimeTarget::RuntimeTarget(const RuntimeModel& model, const std::string& integrator, const std::string& elasticity,
+                             const SimOptions& o)
+    : model_(model), instance_(model, simulationConfig(model, integrator, elasticity, o)) {
+  const double stable = qv_instance_stable_time_step(instance_.get());
+  if (instance_.config().integrator == QV_INTEGRATOR_CENTRAL_DIFFERENCES && instance_.config().time_step > stable)
+    std::cerr << "quiver: warning: --dt " << instance_.config().time_step << " s is above central differences' stable step "
+              << stable << " s\n";
+}
+
+void RuntimeTarget::addVertexForce(int vertex, const double force[3]) {
+  qv_instance_add_vertex_force(instance_.get(), vertex, force);
+}
+
+void RuntimeTarget::setGravity(const double g[3]) { qv_instance_set_gravity(instance_.get(), g); }
+
+void RuntimeTarget::setSprings(const std::vector<int>& vertices, const std::vector<double>& targets, double stiffness) {
+  qv_instance_set_constraint(instance_.get(), 0, vertices.data(), static_cast<int>(vertices.size()), targets.data(),
+                             stiffness);
+}
+
+void RuntimeTarget::clearSprings() { qv_instance_clear_constraint(instance_.get(), 0); }
+
+int RuntimeTarget::step(int& newton) {
+  newton = instance_.config().integrator == QV_INTEGRATOR_CENTRAL_DIFFERENCES ? 0 : instance_.config().newton_iterations;
+  const qv_step_status status = qv_instance_step(instance_.get());
+  indefinite_ += status == QV_STEP_INDEFINITE;
+  return status == QV_STEP_RESET ? 1 : 0;
+}
+
+void RuntimeTarget::displacement(std::vector<double>& u) const {
+  const std::vector<float> p = instance_.positions();
+  const double* rest = qv_model_rest_positions(model_.get());
+  u.resize(p.size());
+  for (size_t i = 0; i < p.size(); ++i) u[i] = p[i] - rest[i];
+}
+
+void RuntimeTarget::energies(double& kinetic, double& elastic) const {
+  qv_instance_energies(instance_.get(), &kinetic, &elastic);
+}
+
+} // namespace quiver::app

@@ -1,0 +1,33 @@
+#pragma once
+// The runtime library as a scenario target: what `quiver sim` measures and `quiver render` draws.
+#include <string>
+
+#include "apps/sim_scenario.h"
+#include "apps/support/runtime_model.h"
+
+namespace quiver::app {
+
+class RuntimeTarget : public ScenarioTarget {
+public:
+  // `integrator`: newmark | euler | central; `elasticity`: stvk | linear | warping.
+  RuntimeTarget(const RuntimeModel& model, const std::string& integrator, const std::string& elasticity,
+                const SimOptions& options);
+  void addVertexForce(int vertex, const double force[3]) override;
+  void setGravity(const double acceleration[3]) override;
+  void setSprings(const std::vector<int>& vertices, const std::vector<double>& targets, double stiffness) override;
+  void clearSprings() override;
+  int step(int& newtonIterations) override;
+  void displacement(std::vector<double>& u) const override;
+  void energies(double& kinetic, double& elastic) const override;
+  double timeStep() const override { return instance_.config().time_step; }
+
+  const RuntimeInstance& instance() const { return instance_; }
+  int indefiniteSteps() const { return indefinite_; }
+
+private:
+  const RuntimeModel& model_;
+  RuntimeInstance instance_;
+  int indefinite_ = 0;
+};
+
+} // namespace quiver::app

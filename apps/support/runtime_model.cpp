@@ -1,0 +1,56 @@
+#include "apps/support/runtime_model.h"
+
+#include <stdexcept>
+
+#include "formats/mesh/read_mesh.h"
+#include "formats/model/qvr.h"
+
+namespace quiver::app {
+
+RuntimeModel::RuntimeModel(const std::string& path) : path_(path) {
+  char message[1024] = "";
+  if (qv_model_load_file(path.c_str(), nullptr, nullptr, &model_, message, sizeof message) != QV_OK)
+    throw std::runtime_error(message);
+  qv_model_get_info(model_, &info_);
+}
+
+RuntimeModel::~RuntimeModel() { qv_model_destroy(model_); }
+
+std::vector<unsigned> RuntimeModel::triangles() const {
+  const unsigned* t = qv_model_triangles(model_);
+  return std::vector<unsigned>(t, t + 3 * static_cast<size_t>(info_.triangle_count));
+}
+
+TetMesh RuntimeModel::mesh() const {
+  // The runtime keeps no tets (it does not need them); the file has them.
+  const std::string bytes = readFileBytes(path_);
+  ModelView view;
+  std::string error;
+  if (!parseModel(bytes.data(), bytes.size(), view, error)) throw std::runtime_error(path_ + ": " + error);
+  TetMesh mesh;
+  for (uint32_t v = 0; v < view.info.vertexCount; ++v)
+    mesh.vertices.emplace_back(view.restPositions[3 * v], view.restPositions[3 * v + 1], view.restPositions[3 * v + 2]);
+  if (view.tets)
+    for (uint32_t t = 0; t < view.info.tetCount; ++t)
+      mesh.tets.push_back({int(view.tets[4 * t]), int(view.tets[4 * t + 1]), int(view.tets[4 * t + 2]), int(view.tets[4 * t + 3])});
+  mesh.tetRegion.assign(mesh.tets.size(), 0);
+  return mesh;
+}
+
+RuntimeInstance::RuntimeInstance(const RuntimeModel& model, const qv_instance_config& config)
+    : config_(config), vertexCount_(static_cast<size_t>(model.info().vertex_count)) {
+  if (qv_instance_create(model.get(), &config_, nullptr, &instance_) != QV_OK)
+    throw std::runtime_error(config_.warping && !model.info().has_modal_rotations
+                                 ? model.path() + " has no modal rotations (bake it again for modal warping)"
+                                 : "invalid simulation settings (time step, Newton iterations, damping)");
+}
+
+RuntimeInstance::~RuntimeInstance() { qv_instance_destroy(instance_); }
+
+std::vector<float> RuntimeInstance::positions() const {
+  std::vector<float> p(3 * vertexCount_);
+  qv_instance_positions(instance_, p.data());
+  return p;
+}
+
+} // namespace quiver::app
