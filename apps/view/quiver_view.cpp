@@ -1,0 +1,379 @@
+// quiver-view: a baked model, live. Drag a surface point with the mouse (a spring to the cursor
+// ray), let go and watch it ring; change integrator, time step, damping and gravity; browse the
+// linear modes and basis vectors. Steps at the model's fixed rate, whatever the frame rate.
+// `--frames N --screenshot out.png [--drag-script FILE]` runs a bounded, deterministic session
+// (1/60 s per frame) for tests and recordings.
+#include <algorithm>
+#include <cstdio>
+#include <deque>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+
+#include <epoxy/gl.h>
+// epoxy first: it replaces the GL header GLFW would include.
+#include <GLFW/glfw3.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+
+#include "apps/render/software_renderer.h"
+#include "apps/support/mesh_options.h"
+#include "apps/view/drag_script.h"
+#include "apps/view/orbit_camera.h"
+#include "apps/view/surface_pick.h"
+#include "apps/view/surface_view.h"
+#include "apps/view/view_session.h"
+
+namespace quiver::app {
+
+namespace {
+
+constexpr double kScriptedFrameSeconds = 1.0 / 60;
+
+struct ViewOptions {
+  std::string model;
+  std::vector<int> size{1280, 800};
+  int frames = 0;  // > 0: stop after this many frames
+  std::string screenshot;
+  std::string dragScript;
+  bool noPanel = false;
+  std::string showMode;  // "linear:N" or "basis:N": start in the mode browser
+  std::string integrator = "newmark", elasticity = "stvk";
+  ViewSettings settings;
+};
+
+// The window, its GL context and Dear ImGui, torn down in the right order.
+class Window {
+public:
+  Window(int width, int height, const std::string& title, bool bounded) {
+    glfwSetErrorCallback([](int, const char* description) { lastError() = description; });
+    if (!glfwInit())
+      throw std::runtime_error("cannot open a window (" + lastError() + "); without a display, run under xvfb-run");
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    glfwWindowHint(GLFW_SAMPLES, 4);
+    window_ = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+    if (!window_) {
+      glfwTerminate();
+      throw std::runtime_error("cannot create an OpenGL 3.3 core window (" + lastError() + ")");
+    }
+    glfwMakeContextCurrent(window_);
+    glfwSwapInterval(bounded ? 0 : 1);  // a bounded run does not wait for the display
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini left in the user's folder
+    ImGui::StyleColorsDark();
+  }
+  // After the application's own GLFW callbacks are set: ImGui chains to them.
+  void startImGui() {
+    ImGui_ImplGlfw_InitForOpenGL(window_, true);
+    ImGui_ImplOpenGL3_Init("#version 330 core");
+    imgui_ = true;
+  }
+  ~Window() {
+    if (imgui_) {
+      ImGui_ImplOpenGL3_Shutdown();
+      ImGui_ImplGlfw_Shutdown();
+    }
+    ImGui::DestroyContext();
+    glfwDestroyWindow(window_);
+    glfwTerminate();
+  }
+  GLFWwindow* get() const { return window_; }
+
+private:
+  static std::string& lastError() {
+    static std::string message = "no reason given";
+    return message;
+  }
+  GLFWwindow* window_ = nullptr;
+  bool imgui_ = false;
+};
+
+// The front buffer as it will be shown, saved as a PNG (GL's rows run bottom-up).
+void saveScreenshot(const std::string& path, int width, int height) {
+  Image image(width, height);
+  std::vector<uint8_t> rows(3 * static_cast<size_t>(width) * height);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadBuffer(GL_BACK);
+  glReadPixels(0, 0, width, height, GL_RGB, GL_UNSIGNED_BYTE, rows.data());
+  const size_t stride = 3 * static_cast<size_t>(width);
+  for (int y = 0; y < height; ++y)
+    std::copy_n(&rows[stride * (height - 1 - y)], stride, &image.rgb[stride * y]);
+  writePng(path, image);
+}
+
+class Viewer {
+public:
+  Viewer(const ViewOptions& o, const RuntimeModel& model)
+      : o_(o), model_(model), session_(model, o.settings), triangles_(model.triangles()),
+        camera_(OrbitCamera::framing(Eigen::Vector3d(model.info().bbox_min), Eigen::Vector3d(model.info().bbox_max))),
+        size_((Eigen::Vector3d(model.info().bbox_max) - Eigen::Vector3d(model.info().bbox_min)).norm()) {
+    edited_ = session_.settings();
+    if (!o.dragScript.empty()) script_ = DragScript::load(o.dragScript);
+    if (!o.showMode.empty()) {
+      const size_t colon = o.showMode.find(':');
+      const std::string kind = o.showMode.substr(0, colon);
+      size_t used = 0;
+      try {
+        modeIndex_ = colon == std::string::npos ? -1 : std::stoi(o.showMode.substr(colon + 1), &used);
+      } catch (const std::exception&) {
+        modeIndex_ = -1;
+      }
+      if ((kind != "linear" && kind != "basis") || modeIndex_ < 0 || modeIndex_ >= model.info().r ||
+          colon + 1 + used != o.showMode.size())
+        throw std::runtime_error("--show-mode " + o.showMode + ": expected linear:N or basis:N with N from 0 to " +
+                                 std::to_string(model.info().r - 1));
+      modeKind_ = kind == "linear" ? 1 : 2;
+      session_.showMode(ModeKind(modeKind_), modeIndex_, modeAmplitude_ * size_);
+    }
+  }
+
+  int run() {
+    Window window(o_.size[0], o_.size[1], "quiver-view: " + std::filesystem::path(o_.model).filename().string(),
+                  o_.frames > 0);
+    glfwSetWindowUserPointer(window.get(), this);
+    glfwSetScrollCallback(window.get(), [](GLFWwindow* w, double, double dy) {
+      if (!ImGui::GetIO().WantCaptureMouse) static_cast<Viewer*>(glfwGetWindowUserPointer(w))->camera_.zoom(std::pow(0.9, dy));
+    });
+    glfwSetKeyCallback(window.get(), [](GLFWwindow* w, int key, int, int action, int) {
+      if (action == GLFW_PRESS && !ImGui::GetIO().WantCaptureKeyboard && key == GLFW_KEY_R)
+        static_cast<Viewer*>(glfwGetWindowUserPointer(w))->session_.reset();
+    });
+    window.startImGui();
+    SurfaceView surface(triangles_, model_.info().vertex_count);
+    double last = glfwGetTime(), rateStart = last;
+    long rateSteps = 0;
+    for (int frame = 0; !glfwWindowShouldClose(window.get()) && (o_.frames == 0 || frame < o_.frames); ++frame) {
+      glfwPollEvents();
+      const double now = glfwGetTime();
+      const double elapsed = o_.frames > 0 ? kScriptedFrameSeconds : std::min(now - last, 0.1);
+      last = now;
+      int width = 0, height = 0, fbWidth = 0, fbHeight = 0;
+      glfwGetWindowSize(window.get(), &width, &height);
+      glfwGetFramebufferSize(window.get(), &fbWidth, &fbHeight);
+
+      ImGui_ImplOpenGL3_NewFrame();
+      ImGui_ImplGlfw_NewFrame();
+      ImGui::NewFrame();
+      handleMouse(window.get(), frame, width, height);
+      rateSteps += session_.advance(elapsed);
+      // Steps per wall-clock second, over the last half second (a running value before the first).
+      if (now - rateStart > 0.05) stepsPerSecond_ = rateSteps / (now - rateStart);
+      if (now - rateStart >= 0.5) {
+        rateStart = now;
+        rateSteps = 0;
+      }
+      energy_.push_back(static_cast<float>(session_.kineticEnergy() + session_.elasticEnergy()));
+      if (energy_.size() > 300) energy_.pop_front();
+      if (!o_.noPanel) panel();
+      ImGui::Render();
+
+      glViewport(0, 0, fbWidth, fbHeight);
+      glClearColor(0.93f, 0.94f, 0.96f, 1);
+      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      session_.positions(positions_);
+      normals_.resize(positions_.size());
+      qv_model_surface_normals(model_.get(), positions_.data(), normals_.data());
+      surface.update(positions_, normals_);
+      const Eigen::Matrix4f view = camera_.view(), projection = camera_.projection(double(fbWidth) / std::max(fbHeight, 1));
+      surface.draw(view, projection, Eigen::Vector3f(0.27f, 0.51f, 0.71f), smoothNormals_);
+      if (session_.grabbing()) {
+        const int v = session_.grabbedVertex();
+        const Eigen::Vector3d& t = session_.grabTarget();
+        surface.drawLines({positions_[3 * v], positions_[3 * v + 1], positions_[3 * v + 2], float(t.x()), float(t.y()),
+                           float(t.z())},
+                          view, projection, Eigen::Vector3f(0.85f, 0.25f, 0.2f));
+      }
+      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+      if (o_.frames > 0 && frame + 1 == o_.frames && !o_.screenshot.empty()) saveScreenshot(o_.screenshot, fbWidth, fbHeight);
+      glfwSwapBuffers(window.get());
+    }
+    if (o_.frames > 0)
+      std::printf("quiver-view: %d frames, %ld steps of %g s, %d resets, %d grabs\n", o_.frames, session_.stepsTaken(),
+                  session_.config().time_step, session_.resets(), grabs_);
+    return 0;
+  }
+
+private:
+  // One cursor, from the script or the mouse: press picks a surface point (drag it) or the
+  // background (orbit); holding moves the spring's target in the plane through the picked point
+  // facing the camera; release lets go.
+  void handleMouse(GLFWwindow* window, int frame, int width, int height) {
+    ScriptedCursor cursor;
+    if (script_) {
+      cursor = script_->at(frame);
+      cursor.x *= width;
+      cursor.y *= height;
+    } else {
+      glfwGetCursorPos(window, &cursor.x, &cursor.y);
+      cursor.down = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+      if (cursor.down && !mouseDown_ && ImGui::GetIO().WantCaptureMouse) cursor.down = false;  // a click on the panel
+    }
+    const Ray ray = camera_.ray(cursor.x, cursor.y, width, height);
+    if (cursor.down && !mouseDown_) {
+      session_.positions(positions_);
+      if (const std::optional<SurfaceHit> hit = pickSurface(ray, positions_, triangles_)) {
+        dragPoint_ = hit->point;
+        dragNormal_ = (camera_.eye() - camera_.target).normalized();
+        session_.grab(hit->vertex, hit->point);
+        ++grabs_;
+      } else if (script_) {
+        std::fprintf(stderr, "quiver-view: warning: the scripted press at frame %d misses the model\n", frame);
+      }
+    } else if (cursor.down && session_.grabbing()) {
+      if (const auto target = intersectPlane(ray, dragPoint_, dragNormal_)) session_.grab(session_.grabbedVertex(), *target);
+    } else if (cursor.down) {
+      camera_.orbit(-0.3 * (cursor.x - lastX_), 0.3 * (cursor.y - lastY_));
+    } else if (mouseDown_ && session_.grabbing()) {
+      session_.release();
+    }
+    mouseDown_ = cursor.down;
+    lastX_ = cursor.x;
+    lastY_ = cursor.y;
+  }
+
+  void panel() {
+    const qv_model_info& info = model_.info();
+    ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(430, 0), ImGuiCond_FirstUseEver);
+    ImGui::Begin("quiver-view");
+    ImGui::PushItemWidth(-170);  // room for the labels
+    ImGui::Text("r = %d, %d vertices, %d tets", info.r, info.vertex_count, info.tet_count);
+    ImGui::Text("%.0f steps/s; a step costs %.1f us (%.0f/s possible)", stepsPerSecond_, session_.stepMicros(),
+                session_.stepMicros() > 0 ? 1e6 / session_.stepMicros() : 0.0);
+    if (session_.behindRealTime()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "slower than real time");
+    if (session_.resets()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%d resets (diverged, back to rest)", session_.resets());
+    ImGui::Text("energy: kinetic %.3g J, elastic %.3g J", session_.kineticEnergy(), session_.elasticEnergy());
+    std::vector<float> energy(energy_.begin(), energy_.end());
+    ImGui::PlotLines("total", energy.data(), static_cast<int>(energy.size()), 0, nullptr, 0, FLT_MAX, ImVec2(0, 50));
+
+    if (ImGui::CollapsingHeader("Simulation", ImGuiTreeNodeFlags_DefaultOpen)) {
+      static const char* integrators[] = {"implicit Newmark", "backward Euler", "central differences"};
+      int integrator = edited_.integrator;
+      if (ImGui::Combo("integrator", &integrator, integrators, 3)) edited_.integrator = qv_integrator(integrator);
+      static const char* elasticities[] = {"St.Venant-Kirchhoff", "linear modal", "modal warping"};
+      int elasticity = static_cast<int>(edited_.elasticity);
+      if (ImGui::Combo("elasticity", &elasticity, elasticities, info.has_modal_rotations ? 3 : 2))
+        edited_.elasticity = Elasticity(elasticity);
+      double stepMs = 1000 * session_.config().time_step;
+      if (ImGui::InputDouble("time step, ms", &stepMs, 0.5, 5, "%.3f", ImGuiInputTextFlags_EnterReturnsTrue) && stepMs > 0)
+        edited_.timeStep = stepMs / 1000;
+      if (edited_.integrator == QV_INTEGRATOR_CENTRAL_DIFFERENCES)
+        ImGui::Text("stable below %.3f ms", 1000 * session_.stableTimeStep());
+      else
+        ImGui::SliderInt("Newton iterations", &edited_.newtonIterations, 1, 5);
+      double alpha = session_.config().rayleigh_alpha, beta = session_.config().rayleigh_beta;
+      if (ImGui::InputDouble("damping alpha, 1/s", &alpha, 0, 0, "%.4g", ImGuiInputTextFlags_EnterReturnsTrue))
+        edited_.alpha = std::max(alpha, 0.0);
+      if (ImGui::InputDouble("damping beta, s", &beta, 0, 0, "%.4g", ImGuiInputTextFlags_EnterReturnsTrue))
+        edited_.beta = std::max(beta, 0.0);
+      ImGui::Checkbox("gravity", &edited_.gravity);
+      float spring = static_cast<float>(edited_.springStiffness);
+      if (ImGui::SliderFloat("mouse spring, N/m", &spring, 1e-3f * spring + 1e-9f, 1e3f * spring, "%.3g",
+                             ImGuiSliderFlags_Logarithmic))
+        edited_.springStiffness = spring;
+      if (ImGui::Button("reset (R)")) session_.reset();
+      if (!(edited_ == session_.settings())) {
+        try {
+          session_.configure(edited_);
+          settingsError_.clear();
+        } catch (const std::exception& e) {
+          settingsError_ = e.what();
+        }
+        edited_ = session_.settings();
+      }
+      if (!settingsError_.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%s", settingsError_.c_str());
+    }
+
+    if (ImGui::CollapsingHeader("Modes", ImGuiTreeNodeFlags_DefaultOpen)) {
+      bool changed = ImGui::RadioButton("simulate", &modeKind_, 0);
+      ImGui::SameLine();
+      changed |= ImGui::RadioButton("linear modes", &modeKind_, 1);
+      ImGui::SameLine();
+      changed |= ImGui::RadioButton("basis vectors", &modeKind_, 2);
+      if (modeKind_ != 0) {
+        changed |= ImGui::SliderInt("index", &modeIndex_, 0, info.r - 1);
+        changed |= ImGui::SliderFloat("amplitude", &modeAmplitude_, 0.01f, 0.5f, "%.2f of the size");
+        if (modeKind_ == 1) {
+          const double hz = std::sqrt(std::max(session_.modes().eigenvalues[modeIndex_], 0.0)) / (2 * M_PI);
+          ImGui::Text("%.4g Hz in the reduced model", hz);
+          if (modeIndex_ < info.eigenvalue_count)
+            ImGui::Text("%.4g Hz baked (full mesh)", std::sqrt(std::max(qv_model_eigenvalues(model_.get())[modeIndex_], 0.0)) / (2 * M_PI));
+        }
+        ImGui::TextDisabled("shown at one oscillation per %.1f s", ViewSession::kModePeriod);
+      }
+      if (changed) session_.showMode(ModeKind(modeKind_), modeIndex_, modeAmplitude_ * size_);
+    }
+    ImGui::Checkbox("smooth normals (the runtime's)", &smoothNormals_);
+    ImGui::TextDisabled("left-drag the model: pull it\nleft-drag around it: orbit; wheel: zoom");
+    ImGui::PopItemWidth();
+    ImGui::End();
+  }
+
+  const ViewOptions& o_;
+  const RuntimeModel& model_;
+  ViewSession session_;
+  ViewSettings edited_;
+  std::string settingsError_;
+  std::vector<unsigned> triangles_;
+  std::vector<float> positions_, normals_;
+  OrbitCamera camera_;
+  double size_;
+  std::optional<DragScript> script_;
+  bool mouseDown_ = false;
+  double lastX_ = 0, lastY_ = 0;
+  Eigen::Vector3d dragPoint_, dragNormal_;
+  int grabs_ = 0;
+  double stepsPerSecond_ = 0;
+  std::deque<float> energy_;
+  int modeKind_ = 0, modeIndex_ = 0;
+  float modeAmplitude_ = 0.1f;
+  bool smoothNormals_ = false;
+};
+
+} // namespace
+
+} // namespace quiver::app
+
+int main(int argc, char** argv) {
+  using namespace quiver::app;
+  CLI::App app{"quiver-view: simulate a baked model (.qvr) interactively"};
+  ViewOptions o;
+  app.add_option("model", o.model, "Model file (.qvr)")->required();
+  app.add_option("--size", o.size, "Window width,height in pixels")->delimiter(',')->expected(2)->capture_default_str();
+  app.add_option("--integrator", o.integrator, "newmark, euler or central")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"newmark", "euler", "central"}));
+  app.add_option("--elasticity", o.elasticity, "stvk, linear or warping")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"stvk", "linear", "warping"}));
+  app.add_option("--dt", o.settings.timeStep, "Time step, s (default: the model's)")->check(CLI::PositiveNumber);
+  app.add_option("--newton", o.settings.newtonIterations, "Newton iterations per implicit step")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 20));
+  app.add_flag("--gravity", o.settings.gravity, "Start with gravity, 9.81 m/s^2 along -z");
+  app.add_option("--frames", o.frames, "Run this many frames (1/60 s of simulation each), then exit")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--screenshot", o.screenshot, "With --frames: save the last frame as a PNG");
+  app.add_option("--drag-script", o.dragScript, "Drive the mouse from a script (apps/view/drag_script.h)");
+  app.add_flag("--no-panel", o.noPanel, "Hide the control panel");
+  app.add_option("--show-mode", o.showMode, "Start in the mode browser: linear:N (a linear mode) or basis:N (a basis vector)");
+  return runTool("quiver-view", app, argc, argv, [&] {
+    if (o.size.size() != 2 || o.size[0] < 64 || o.size[1] < 64 || o.size[0] > 8192 || o.size[1] > 8192)
+      throw std::runtime_error("--size must be two numbers between 64 and 8192");
+    if (!o.screenshot.empty() && o.frames == 0) throw std::runtime_error("--screenshot needs --frames N");
+    o.settings.integrator = o.integrator == "euler"     ? QV_INTEGRATOR_BACKWARD_EULER
+                            : o.integrator == "central" ? QV_INTEGRATOR_CENTRAL_DIFFERENCES
+                                                        : QV_INTEGRATOR_IMPLICIT_NEWMARK;
+    o.settings.elasticity = o.elasticity == "linear"    ? Elasticity::Linear
+                            : o.elasticity == "warping" ? Elasticity::Warping
+                                                        : Elasticity::StVK;
+    const RuntimeModel model(o.model);
+    Viewer viewer(o, model);
+    return viewer.run();
+  });
+}

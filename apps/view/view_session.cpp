@@ -1,0 +1,154 @@
+#include "apps/view/view_session.h"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+namespace quiver::app {
+
+bool ViewSettings::operator==(const ViewSettings& o) const {
+  return integrator == o.integrator && elasticity == o.elasticity && timeStep == o.timeStep &&
+         newtonIterations == o.newtonIterations && alpha == o.alpha && beta == o.beta && gravity == o.gravity &&
+         springStiffness == o.springStiffness;
+}
+
+namespace {
+
+qv_instance_config instanceConfig(const RuntimeModel& model, const ViewSettings& s) {
+  qv_instance_config c;
+  qv_instance_config_init(&c, model.get());
+  c.integrator = s.integrator;
+  if (s.timeStep > 0) c.time_step = s.timeStep;
+  c.newton_iterations = s.newtonIterations;
+  if (s.alpha >= 0) c.rayleigh_alpha = s.alpha;
+  if (s.beta >= 0) c.rayleigh_beta = s.beta;
+  c.linear = s.elasticity == Elasticity::Linear;
+  c.warping = s.elasticity == Elasticity::Warping;
+  return c;
+}
+
+// A spring that moves the object visibly without fighting the solver: three times the stiffness
+// the whole mass has in the first mode (k = m omega_1^2).
+double defaultSpringStiffness(const RuntimeModel& model, const ReducedModes& modes) {
+  const double lambda = modes.eigenvalues.size() ? std::max(modes.eigenvalues[0], 1e-12) : 1.0;
+  return 3 * model.info().total_mass * lambda;
+}
+
+} // namespace
+
+ViewSession::ViewSession(const RuntimeModel& model, const ViewSettings& settings)
+    : model_(model), settings_(settings), modes_(reducedModes(model.get())) {
+  if (settings_.springStiffness <= 0) settings_.springStiffness = defaultSpringStiffness(model, modes_);
+  instance_ = std::make_unique<RuntimeInstance>(model_, instanceConfig(model_, settings_));
+  applyLoads();
+}
+
+void ViewSession::configure(const ViewSettings& wanted) {
+  ViewSettings s = wanted;
+  if (s.springStiffness <= 0) s.springStiffness = defaultSpringStiffness(model_, modes_);
+  const qv_instance_config next = instanceConfig(model_, s), now = instance_->config();
+  const bool same = next.integrator == now.integrator && next.time_step == now.time_step &&
+                    next.newton_iterations == now.newton_iterations && next.rayleigh_alpha == now.rayleigh_alpha &&
+                    next.rayleigh_beta == now.rayleigh_beta && next.linear == now.linear && next.warping == now.warping;
+  if (!same) {
+    auto replacement = std::make_unique<RuntimeInstance>(model_, next);  // throws before anything changes
+    const int r = model_.info().r;
+    std::vector<double> q(r), v(r);
+    qv_instance_get_state(instance_->get(), q.data(), v.data(), nullptr);
+    instance_ = std::move(replacement);
+    settings_ = s;
+    applyLoads();
+    qv_instance_set_state(instance_->get(), q.data(), v.data(), nullptr);
+  } else {
+    settings_ = s;
+    applyLoads();
+  }
+}
+
+void ViewSession::applyLoads() {
+  const double g[3] = {0, 0, settings_.gravity ? -9.81 : 0};
+  qv_instance_set_gravity(instance_->get(), g);
+  if (grabbed_ >= 0) {
+    qv_instance_set_constraint(instance_->get(), 0, &grabbed_, 1, grabTarget_.data(), settings_.springStiffness);
+  } else {
+    qv_instance_clear_constraint(instance_->get(), 0);
+  }
+}
+
+int ViewSession::advance(double seconds) {
+  if (modeKind_ != ModeKind::None) {
+    modeTime_ = std::fmod(modeTime_ + seconds, kModePeriod);
+    return 0;
+  }
+  const double h = instance_->config().time_step;
+  accumulator_ += seconds;
+  int taken = 0;
+  while (accumulator_ >= h && taken < kMaxStepsPerFrame) {
+    const auto start = std::chrono::steady_clock::now();
+    resets_ += qv_instance_step(instance_->get()) == QV_STEP_RESET;
+    const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+    stepMicros_ = steps_ == 0 ? us : 0.98 * stepMicros_ + 0.02 * us;
+    accumulator_ -= h;
+    ++taken;
+    ++steps_;
+  }
+  behind_ = accumulator_ >= h;
+  if (behind_) accumulator_ = 0;  // drop what cannot be caught up, rather than spiral
+  return taken;
+}
+
+void ViewSession::grab(int vertex, const Eigen::Vector3d& target) {
+  grabbed_ = vertex;
+  grabTarget_ = target;
+  applyLoads();
+}
+
+void ViewSession::release() {
+  grabbed_ = -1;
+  applyLoads();
+}
+
+void ViewSession::reset() {
+  qv_instance_reset(instance_->get());
+  accumulator_ = 0;
+}
+
+void ViewSession::showMode(ModeKind kind, int index, double amplitude) {
+  modeKind_ = kind;
+  modeTime_ = 0;
+  if (kind == ModeKind::None) return;
+  const int r = model_.info().r;
+  if (index < 0 || index >= r) throw std::out_of_range("mode " + std::to_string(index) + " of " + std::to_string(r));
+  Eigen::VectorXd q = kind == ModeKind::LinearMode ? Eigen::VectorXd(modes_.vectors.col(index)) : Eigen::VectorXd::Unit(r, index);
+  std::vector<float> u(3 * static_cast<size_t>(model_.info().vertex_count));
+  qv_model_displacements(model_.get(), q.data(), u.data());
+  float largest = 0;
+  for (float x : u) largest = std::max(largest, std::abs(x));
+  modeShape_ = largest > 0 ? Eigen::VectorXd(q * (amplitude / largest)) : Eigen::VectorXd::Zero(r);
+}
+
+void ViewSession::positions(std::vector<float>& out) const {
+  out.resize(3 * static_cast<size_t>(model_.info().vertex_count));
+  if (modeKind_ == ModeKind::None) {
+    qv_instance_positions(instance_->get(), out.data());
+    return;
+  }
+  const Eigen::VectorXd q = std::sin(2 * M_PI * modeTime_ / kModePeriod) * modeShape_;
+  qv_model_displacements(model_.get(), q.data(), out.data());
+  const double* rest = qv_model_rest_positions(model_.get());
+  for (size_t i = 0; i < out.size(); ++i) out[i] += static_cast<float>(rest[i]);
+}
+
+double ViewSession::kineticEnergy() const {
+  double kinetic = 0, elastic = 0;
+  qv_instance_energies(instance_->get(), &kinetic, &elastic);
+  return kinetic;
+}
+
+double ViewSession::elasticEnergy() const {
+  double kinetic = 0, elastic = 0;
+  qv_instance_energies(instance_->get(), &kinetic, &elastic);
+  return elastic;
+}
+
+} // namespace quiver::app

@@ -1,0 +1,92 @@
+#pragma once
+// What the viewer simulates and shows, without any window or GL: the runtime instance and its
+// settings, fixed-rate stepping decoupled from the frame rate, the mouse spring, and the mode
+// browser's animation. quiver-view draws it; tests drive it directly.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "apps/support/reduced_modes.h"
+#include "apps/support/runtime_model.h"
+
+namespace quiver::app {
+
+enum class Elasticity { StVK = 0, Linear = 1, Warping = 2 };
+enum class ModeKind { None = 0, LinearMode = 1, BasisVector = 2 };
+
+struct ViewSettings {
+  qv_integrator integrator = QV_INTEGRATOR_IMPLICIT_NEWMARK;
+  Elasticity elasticity = Elasticity::StVK;
+  double timeStep = 0;           // s; 0: the model's
+  int newtonIterations = 2;      // one is the paper's default, two keep a stiff mouse spring converged
+  double alpha = -1, beta = -1;  // Rayleigh damping; negative: the model's
+  bool gravity = false;
+  double springStiffness = 0;    // N/m of the mouse spring; 0: scaled to the model (see ViewSession)
+
+  bool operator==(const ViewSettings& o) const;
+};
+
+class ViewSession {
+public:
+  static constexpr int kMaxStepsPerFrame = 64;  // beyond this the simulation runs slower than real time
+  static constexpr double kModePeriod = 1.5;    // s per oscillation in the mode browser, whatever the frequency
+
+  ViewSession(const RuntimeModel& model, const ViewSettings& settings);
+
+  const RuntimeModel& model() const { return model_; }
+  const ViewSettings& settings() const { return settings_; }
+  const qv_instance_config& config() const { return instance_->config(); }
+  // Takes new settings; a new integrator, step, damping or elasticity makes a new instance that
+  // continues from the current displacement and velocity. Throws if the runtime refuses them (the
+  // old settings stay).
+  void configure(const ViewSettings& settings);
+
+  // Consumes `seconds` of wall-clock time in whole steps of the time step (at most
+  // kMaxStepsPerFrame; what cannot be caught up is dropped). Returns the steps taken. While a mode
+  // is shown, only the mode's animation advances.
+  int advance(double seconds);
+  bool behindRealTime() const { return behind_; }
+
+  // The mouse spring: pulls `vertex` toward `target`.
+  void grab(int vertex, const Eigen::Vector3d& target);
+  void release();
+  bool grabbing() const { return grabbed_ >= 0; }
+  int grabbedVertex() const { return grabbed_; }
+  const Eigen::Vector3d& grabTarget() const { return grabTarget_; }
+
+  void reset();
+  void showMode(ModeKind kind, int index, double amplitude);  // amplitude: largest vertex displacement, m
+  ModeKind shownMode() const { return modeKind_; }
+  const ReducedModes& modes() const { return modes_; }
+
+  // Deformed positions (3 floats per vertex): the simulation, or the shown mode.
+  void positions(std::vector<float>& out) const;
+  double kineticEnergy() const;
+  double elasticEnergy() const;
+  long stepsTaken() const { return steps_; }
+  int resets() const { return resets_; }
+  double stepMicros() const { return stepMicros_; }  // moving average of the step's cost
+  double stableTimeStep() const { return qv_instance_stable_time_step(instance_->get()); }  // central differences'
+
+private:
+  void applyLoads();
+
+  const RuntimeModel& model_;
+  ViewSettings settings_;
+  std::unique_ptr<RuntimeInstance> instance_;
+  ReducedModes modes_;
+  double accumulator_ = 0;
+  bool behind_ = false;
+  int grabbed_ = -1;
+  Eigen::Vector3d grabTarget_ = Eigen::Vector3d::Zero();
+  long steps_ = 0;
+  int resets_ = 0;
+  double stepMicros_ = 0;
+  ModeKind modeKind_ = ModeKind::None;
+  Eigen::VectorXd modeShape_;  // reduced coordinates of the shown mode at full amplitude
+  double modeTime_ = 0;
+};
+
+} // namespace quiver::app

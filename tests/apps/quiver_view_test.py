@@ -1,0 +1,119 @@
+#!/usr/bin/python3
+"""quiver-view under Xvfb, as a user would run it: bounded runs with a scripted mouse write
+screenshots, which must show the model, show it moved by the drag, show the panel, and show a mode;
+bad input is refused with a clear message and no screenshot."""
+import os
+import shutil
+import subprocess
+import tempfile
+import unittest
+
+import numpy as np
+
+VIEW = os.environ["QUIVER_VIEW"]
+MODEL = os.environ["QUIVER_MODEL"]
+XVFB_RUN = shutil.which("xvfb-run")
+SIZE = "640,400"
+
+# The suite's beam (0.6 m, fixed at x = min) seen from the default camera: its free end is near the
+# lower left of the window. Press there, drag down over half a second, hold, let go, and look while
+# it still rings.
+DRAG = """# frame action x y
+10 press 0.36 0.68
+40 move 0.36 0.95
+70 release
+"""
+
+
+@unittest.skipUnless(XVFB_RUN, "SKIPPED: xvfb-run not found (Debian package xvfb): cannot open a window here")
+class QuiverView(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.script = os.path.join(cls.tmp.name, "drag.txt")
+        with open(cls.script, "w") as f:
+            f.write(DRAG)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def view(self, *args, display=True):
+        command = [VIEW, MODEL, "--size", SIZE, *map(str, args)]
+        if display:
+            command = [XVFB_RUN, "-a", "-s", "-screen 0 1280x1024x24", *command]
+        return subprocess.run(command, capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
+
+    def shot(self, name, *args):
+        path = os.path.join(self.tmp.name, name)
+        p = self.view("--frames", 90, "--screenshot", path, *args)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        import matplotlib.image
+        image = matplotlib.image.imread(path)[:, :, :3]
+        self.assertEqual(image.shape, (400, 640, 3))
+        return image, p.stdout
+
+    @staticmethod
+    def model_pixels(image):
+        background = image[-1, -1]  # the bottom-right corner: neither panel nor model
+        return np.abs(image - background).max(axis=2) > 0.05
+
+    def test_drag_moves_the_model_and_it_rings_after_release(self):
+        rest, out = self.shot("rest.png", "--no-panel")
+        covered = self.model_pixels(rest).mean()
+        self.assertGreater(covered, 0.02)  # not blank
+        self.assertLess(covered, 0.9)  # the camera frames it
+        self.assertIn("0 grabs", out)
+        dragged, out = self.shot("dragged.png", "--no-panel", "--drag-script", self.script)
+        self.assertIn("1 grabs", out)
+        self.assertIn("0 resets", out)
+        changed = (np.abs(dragged - rest).max(axis=2) > 0.1).mean()
+        self.assertGreater(changed, 0.01, "the screenshot after the drag should differ from the rest pose")
+
+    def test_panel_is_drawn(self):
+        bare, _ = self.shot("bare.png", "--no-panel")
+        panel, _ = self.shot("panel.png")
+        corner = (slice(20, 200), slice(20, 300))  # where the panel opens
+        self.assertGreater(bare[corner].mean(), 0.8)  # light background
+        self.assertLess(panel[corner].mean(), 0.5)  # the dark panel
+        self.assertGreater(len(np.unique(panel[corner].reshape(-1, 3), axis=0)), 10)  # text and widgets, not a flat box
+
+    def test_mode_browser_shows_a_mode(self):
+        rest, _ = self.shot("rest_for_mode.png", "--no-panel")
+        # 23 frames of 1/60 s: about a quarter of the browser's 1.5 s oscillation, near full amplitude.
+        path = os.path.join(self.tmp.name, "mode.png")
+        p = self.view("--frames", 23, "--screenshot", path, "--no-panel", "--show-mode", "linear:0")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        import matplotlib.image
+        mode = matplotlib.image.imread(path)[:, :, :3]
+        self.assertGreater((np.abs(mode - rest).max(axis=2) > 0.1).mean(), 0.01)
+
+    def test_bad_input_is_refused_without_a_screenshot(self):
+        bad = os.path.join(self.tmp.name, "bad.txt")
+        with open(bad, "w") as f:
+            f.write("10 press 0.5 0.5\n5 release\n")
+        shot = os.path.join(self.tmp.name, "never.png")
+        for args, message in ((["--drag-script", bad], "bad.txt:2: frame 5 comes before"),
+                              (["--drag-script", os.path.join(self.tmp.name, "none.txt")], "none.txt"),
+                              (["--show-mode", "linear:99"], "--show-mode linear:99"),
+                              (["--show-mode", "sideways:1"], "expected linear:N or basis:N")):
+            with self.subTest(args=args):
+                p = self.view("--frames", 5, "--screenshot", shot, *args)
+                self.assertEqual(p.returncode, 1, p.stderr)
+                self.assertIn(message, p.stderr)
+                self.assertFalse(os.path.exists(shot))
+        p = self.view("--screenshot", shot)
+        self.assertIn("--screenshot needs --frames", p.stderr)
+        p = subprocess.run([VIEW, os.path.join(self.tmp.name, "none.qvr"), "--frames", "1"], capture_output=True, text=True)
+        self.assertEqual(p.returncode, 1)
+        self.assertIn("none.qvr: cannot open", p.stderr)
+
+    def test_without_a_display_it_says_what_to_do(self):
+        env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+        p = subprocess.run([VIEW, MODEL, "--frames", "1"], capture_output=True, text=True, env=env, timeout=60)
+        self.assertEqual(p.returncode, 1)
+        self.assertIn("xvfb-run", p.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
