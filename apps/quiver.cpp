@@ -10,6 +10,7 @@
 #include "apps/sim_scenario.h"
 #include "apps/support/mesh_options.h"
 #include "apps/support/reduced_modes.h"
+#include "apps/support/scenario_file.h"
 #include "apps/support/runtime_model.h"
 #include "formats/mesh/read_mesh.h"
 #include "formats/model/qvr.h"
@@ -111,6 +112,9 @@ int main(int argc, char** argv) {
   fullSpace->add_option("--nu", fullOptions.material.poissonRatio, "Poisson ratio; overrides the mesh file's");
   fullSpace->add_option("--density", fullOptions.material.density, "Density in kg/m^3; overrides the mesh file's");
   fullSpace->add_option("--final-npy", fullOptions.finalNpy, "Save the final displacement (3N, file vertex order) as .npy");
+  const auto scenarioFiles = [](const std::vector<std::string>& args) {
+    return quiver::app::expandScenarioFiles(args, quiver::app::SimOptions::scenarioOptionNames());
+  };
   return quiver::app::runTool("quiver", app, argc, argv, [&] {
     if (*fullSpace) {
       quiver::CheckedMesh mesh = fullMesh.load("quiver");
@@ -162,5 +166,5 @@ int main(int argc, char** argv) {
     // Full precision: every double printed reads back exactly (nlohmann prints shortest round-trip form).
     std::cout << out.dump(1) << "\n";
     return 0;
-  });
+  }, scenarioFiles);
 }

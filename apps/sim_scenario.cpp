@@ -16,21 +16,38 @@
 namespace quiver::app {
 
 void SimOptions::addScenarioTo(CLI::App& app) {
-  app.add_option("--steps", steps, "Steps to simulate")->capture_default_str()->check(CLI::PositiveNumber);
-  app.add_option("--hold", holdSteps, "Steps the load acts before it is released")->capture_default_str();
-  app.add_option("--group", group, "Loaded vertices, a selector such as \"x>max-1e-6\" (mesh units)")->capture_default_str();
-  app.add_option("--force", force, "Pull: total force on the group, N, as fx,fy,fz")->delimiter(',')->expected(3);
-  app.add_option("--drag", drag, "Drag: move the group's targets by dx,dy,dz (m) over the hold")->delimiter(',')->expected(3);
-  app.add_option("--twist", twist, "Drag: rotate the group's targets by this many degrees over the hold");
-  app.add_option("--axis", axis, "Drag: the twist axis, through the group's centre")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"x", "y", "z"}));
-  app.add_option("--stiffness", stiffness, "Drag: penalty spring per vertex, N/m")->capture_default_str();
-  app.add_flag("--gravity", gravity, "Gravity, 9.81 m/s^2 along -z");
-  app.add_option("--dt", timeStep, "Time step, s")->check(CLI::PositiveNumber);
-  app.add_option("--newton", newton, "Newton iterations per implicit step (full space: the most)")->capture_default_str();
-  app.add_option("--alpha", alpha, "Mass-proportional damping, 1/s");
-  app.add_option("--beta", beta, "Stiffness-proportional damping, s");
+  CLI::Option* options[] = {
+      app.add_option("--steps", steps, "Steps to simulate")->capture_default_str()->check(CLI::PositiveNumber),
+      app.add_option("--hold", holdSteps, "Steps the load acts before it is released")->capture_default_str(),
+      app.add_option("--group", group, "Loaded vertices, a selector such as \"x>max-1e-6\" (mesh units)")->capture_default_str(),
+      app.add_option("--force", force, "Pull: total force on the group, N, as fx,fy,fz")->delimiter(',')->expected(3),
+      app.add_option("--drag", drag, "Drag: move the group's targets by dx,dy,dz (m) over the hold")->delimiter(',')->expected(3),
+      app.add_option("--twist", twist, "Drag: rotate the group's targets by this many degrees over the hold"),
+      app.add_option("--axis", axis, "Drag: the twist axis, through the group's centre")
+          ->capture_default_str()
+          ->check(CLI::IsMember({"x", "y", "z"})),
+      app.add_option("--stiffness", stiffness, "Drag: penalty spring per vertex, N/m")->capture_default_str(),
+      app.add_flag("--gravity", gravity, "Gravity, 9.81 m/s^2 along -z"),
+      app.add_option("--dt", timeStep, "Time step, s")->check(CLI::PositiveNumber),
+      app.add_option("--newton", newton, "Newton iterations per implicit step (full space: the most)")->capture_default_str(),
+      app.add_option("--alpha", alpha, "Mass-proportional damping, 1/s"),
+      app.add_option("--beta", beta, "Stiffness-proportional damping, s"),
+  };
+  // A later value wins, so that options after --scenario FILE override the file's.
+  for (CLI::Option* option : options) option->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  app.add_option("--scenario", scenarioFile,
+                 "Read scenario options from FILE, one 'name = value' per line (apps/support/scenario_file.h)");
+}
+
+std::vector<std::string> SimOptions::scenarioOptionNames() {
+  CLI::App app;
+  SimOptions options;
+  options.addScenarioTo(app);
+  std::vector<std::string> names;
+  for (const CLI::Option* option : app.get_options())
+    for (const std::string& name : option->get_lnames())
+      if (name != "scenario" && name != "help") names.push_back(name);
+  return names;
 }
 
 void SimOptions::addTo(CLI::App& app) {

@@ -29,12 +29,15 @@ struct SimOptions {
   std::string output;                   // NAME: NAME.pvd, NAME_NNNNN.vtu, NAME.csv; "" for none
   int every = 1;                        // write every k-th step
   bool json = false;                    // print one JSON summary instead of text
+  std::string scenarioFile;             // --scenario: expanded before parsing (apps/support/scenario_file.h)
 
   // The scenario: loads, their timing, the integrator's settings (shared by sim, full and render).
   void addScenarioTo(CLI::App& app);
   // The scenario and what `sim` and `full` write: -o, --every, --json.
   void addTo(CLI::App& app);
   bool hasLoad() const;
+  // The option names addScenarioTo defines, without the dashes: what a scenario file may set.
+  static std::vector<std::string> scenarioOptionNames();
 };
 
 // What a scenario drives: the runtime's instance or the full-space simulator.

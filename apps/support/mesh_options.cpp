@@ -1,5 +1,6 @@
 #include "apps/support/mesh_options.h"
 
+#include <algorithm>
 #include <iostream>
 
 namespace quiver::app {
@@ -38,9 +39,19 @@ FixedVertexRequest FixedVertexOptions::resolved() const {
 
 std::vector<int> FixedVertexOptions::select(const CheckedMesh& mesh) const { return selectFixedVertices(mesh, resolved()); }
 
-int runTool(const std::string& tool, CLI::App& app, int argc, char** argv, const std::function<int()>& body) {
+int runTool(const std::string& tool, CLI::App& app, int argc, char** argv, const std::function<int()>& body,
+            const ArgumentRewrite& rewrite) {
+  std::vector<std::string> args(argv + 1, argv + argc);
   try {
-    app.parse(argc, argv);
+    if (rewrite) args = rewrite(args);
+  } catch (const std::exception& e) {
+    std::cerr << tool << ": error: " << e.what() << "\n";
+    return 1;
+  }
+  std::reverse(args.begin(), args.end());  // CLI11 takes them last first
+  if (app.get_name().empty()) app.name(tool);
+  try {
+    app.parse(args);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }

@@ -32,7 +32,12 @@ struct FixedVertexOptions {
   std::vector<int> select(const CheckedMesh& mesh) const;
 };
 
-// Runs `body`, turning any exception into "TOOL: error: message" on stderr and exit code 1.
-int runTool(const std::string& tool, CLI::App& app, int argc, char** argv, const std::function<int()>& body);
+// Rewrites the command line (without the program name) before it is parsed; may throw.
+using ArgumentRewrite = std::function<std::vector<std::string>(const std::vector<std::string>&)>;
+
+// Parses the command line (after `rewrite`, if given) and runs `body`, turning any exception into
+// "TOOL: error: message" on stderr and exit code 1.
+int runTool(const std::string& tool, CLI::App& app, int argc, char** argv, const std::function<int()>& body,
+            const ArgumentRewrite& rewrite = {});
 
 } // namespace quiver::app

@@ -230,6 +230,28 @@ class QuiverRender(OnTheBakedModel):
         # The first linear mode is the first basis vector's largest part, not all of it: the tiles differ.
         self.assertMoved(modes, basis)
 
+    def test_scenario_file(self):
+        scenario = os.path.join(self.tmp.name, "twist.scenario")
+        with open(scenario, "w") as f:
+            f.write("# the free end twisted\ngroup = x>max-1e-6\ntwist = 40  # degrees\nhold = 60\nsteps = 60\n")
+        a, _ = self.render("from_file.png", "--size", "160,100", "--scenario", scenario)
+        b, _ = self.render("explicit.png", "--size", "160,100", "--twist", "40", "--hold", "60", "--steps", "60")
+        with open(a, "rb") as fa, open(b, "rb") as fb:
+            self.assertEqual(fa.read(), fb.read())  # the runtime is deterministic: the same picture
+        # Options after the file override it.
+        c, _ = self.render("override.png", "--size", "160,100", "--scenario", scenario, "--steps", "10")
+        d, _ = self.render("override_explicit.png", "--size", "160,100", "--twist", "40", "--hold", "60", "--steps", "10")
+        with open(c, "rb") as fc, open(d, "rb") as fd:
+            self.assertEqual(fc.read(), fd.read())
+        j = json.loads(subprocess.run([QUIVER, "sim", self.model, "--scenario", scenario, "--json"], capture_output=True,
+                                      text=True, check=True).stdout)
+        self.assertEqual(j["steps"], 60)
+        with open(scenario, "a") as f:
+            f.write("twirl = 3\n")
+        _, p = self.render("never.png", "--scenario", scenario, ok=False)
+        self.assertEqual(p.returncode, 1)
+        self.assertIn("twist.scenario:6: 'twirl' is not a scenario option", p.stderr)
+
     def test_animations(self):
         frames, info = self.frames("pull.gif", "--size", "160,100", "--force", "0,0,-20", "--hold", "20", "--steps",
                                    "40", "--every", "4")
