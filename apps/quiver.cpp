@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
   fullSpace->add_option("--density", fullOptions.material.density, "Density in kg/m^3; overrides the mesh file's");
   fullSpace->add_option("--final-npy", fullOptions.finalNpy, "Save the final displacement (3N, file vertex order) as .npy");
   const auto scenarioFiles = [](const std::vector<std::string>& args) {
-    return quiver::app::expandScenarioFiles(args, quiver::app::SimOptions::scenarioOptionNames());
+    return quiver::app::expandScenarioFiles(args, quiver::app::SimOptions::checkScenarioOption);
   };
   return quiver::app::runTool("quiver", app, argc, argv, [&] {
     if (*fullSpace) {

@@ -80,7 +80,7 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->expected(3)
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(quiver::app::Positive);
   beam->add_option("--cells", cells, "Cells along x,y,z (>= 1)")
       ->delimiter(',')
       ->expected(3)

@@ -9,6 +9,7 @@
 #include "apps/render/software_renderer.h"
 #include "apps/runtime_target.h"
 #include "apps/sim_scenario.h"
+#include "apps/support/mesh_options.h"
 #include "apps/support/reduced_modes.h"
 
 namespace quiver::app {
@@ -48,14 +49,8 @@ public:
     const Eigen::MatrixXd directions =
         o.basis ? Eigen::MatrixXd::Identity(info.r, info.r) : reducedModes(model.get()).vectors;
     const double size = (Eigen::Vector3d(info.bbox_max) - Eigen::Vector3d(info.bbox_min)).norm();
-    std::vector<float> u(3 * static_cast<size_t>(info.vertex_count));
-    for (int j = 0; j < count_; ++j) {
-      Eigen::VectorXd q = directions.col(j);
-      qv_model_displacements(model.get(), q.data(), u.data());
-      float largest = 0;
-      for (float x : u) largest = std::max(largest, std::abs(x));
-      shapes_.push_back(largest > 0 ? Eigen::VectorXd(q * (o.amplitude * size / largest)) : Eigen::VectorXd(0 * q));
-    }
+    for (int j = 0; j < count_; ++j)
+      shapes_.push_back(withLargestDisplacement(model.get(), directions.col(j), o.amplitude * size));
   }
 
   Image draw(double phase) const {
@@ -88,13 +83,14 @@ void RenderOptions::addTo(CLI::App& app) {
   app.add_option("-o,--output", output, "NAME.png (one picture), NAME.gif (animated) or NAME_%04d.png (image sequence)")
       ->required();
   app.add_option("--size", size, "Width,height in pixels")->delimiter(',')->expected(2)->capture_default_str();
-  app.add_option("--modes", modes, "Draw a grid of the first N linear modes instead of one shape (animated: oscillating)");
+  app.add_option("--modes", modes, "Draw a grid of the first N linear modes instead of one shape (animated: oscillating)")
+      ->check(Positive);
   app.add_flag("--basis", basis, "The grid shows the first N basis vectors (columns of U) instead of linear modes");
   app.add_option("--amplitude", amplitude, "Grid: largest displacement of each mode, as a fraction of the model's size")
       ->capture_default_str();
   app.add_option("--every", every, "Animated scenario: a frame every k-th step")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(Positive);
   // Pictures are for looking at, not timing: enough Newton iterations that a strong pull is drawn converged.
   scenario.newton = 3;
   scenario.addScenarioTo(app);
@@ -103,6 +99,7 @@ void RenderOptions::addTo(CLI::App& app) {
 int renderModel(const std::string& path, const RenderOptions& o) {
   if (o.size.size() != 2 || o.size[0] < 16 || o.size[1] < 16 || o.size[0] > 8192 || o.size[1] > 8192)
     throw std::runtime_error("--size must be two numbers between 16 and 8192");
+  if (!(o.amplitude > 0 && o.amplitude <= 1)) throw std::runtime_error("--amplitude must be above 0 and at most 1");
   const RuntimeModel model(path);
   const int width = o.size[0], height = o.size[1];
   if (o.modes > 0) {

@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 
+#include "apps/support/mesh_options.h"
 #include "common/vertex_selector.h"
 #include "formats/atomic_file.h"
 #include "formats/mesh/write_mesh.h"
@@ -16,44 +17,48 @@
 namespace quiver::app {
 
 void SimOptions::addScenarioTo(CLI::App& app) {
-  CLI::Option* options[] = {
-      app.add_option("--steps", steps, "Steps to simulate")->capture_default_str()->check(CLI::PositiveNumber),
-      app.add_option("--hold", holdSteps, "Steps the load acts before it is released")->capture_default_str(),
-      app.add_option("--group", group, "Loaded vertices, a selector such as \"x>max-1e-6\" (mesh units)")->capture_default_str(),
-      app.add_option("--force", force, "Pull: total force on the group, N, as fx,fy,fz")->delimiter(',')->expected(3),
-      app.add_option("--drag", drag, "Drag: move the group's targets by dx,dy,dz (m) over the hold")->delimiter(',')->expected(3),
-      app.add_option("--twist", twist, "Drag: rotate the group's targets by this many degrees over the hold"),
-      app.add_option("--axis", axis, "Drag: the twist axis, through the group's centre")
-          ->capture_default_str()
-          ->check(CLI::IsMember({"x", "y", "z"})),
-      app.add_option("--stiffness", stiffness, "Drag: penalty spring per vertex, N/m")->capture_default_str(),
-      app.add_flag("--gravity", gravity, "Gravity, 9.81 m/s^2 along -z"),
-      app.add_option("--dt", timeStep, "Time step, s")->check(CLI::PositiveNumber),
-      app.add_option("--newton", newton, "Newton iterations per implicit step (full space: the most)")->capture_default_str(),
-      app.add_option("--alpha", alpha, "Mass-proportional damping, 1/s"),
-      app.add_option("--beta", beta, "Stiffness-proportional damping, s"),
-  };
-  // A later value wins, so that options after --scenario FILE override the file's.
-  for (CLI::Option* option : options) option->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  app.add_option("--steps", steps, "Steps to simulate")->capture_default_str()->check(Positive);
+  app.add_option("--hold", holdSteps, "Steps the load acts before it is released")->capture_default_str();
+  app.add_option("--group", group, "Loaded vertices, a selector such as \"x>max-1e-6\" (mesh units)")->capture_default_str();
+  app.add_option("--force", force, "Pull: total force on the group, N, as fx,fy,fz")->delimiter(',')->expected(3);
+  app.add_option("--drag", drag, "Drag: move the group's targets by dx,dy,dz (m) over the hold")->delimiter(',')->expected(3);
+  app.add_option("--twist", twist, "Drag: rotate the group's targets by this many degrees over the hold");
+  app.add_option("--axis", axis, "Drag: the twist axis, through the group's centre")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"x", "y", "z"}));
+  app.add_option("--stiffness", stiffness, "Drag: penalty spring per vertex, N/m")->capture_default_str();
+  app.add_flag("--gravity", gravity, "Gravity, 9.81 m/s^2 along -z");
+  app.add_option("--dt", timeStep, "Time step, s")->check(Positive);
+  app.add_option("--newton", newton, "Newton iterations per implicit step (full space: the most)")->capture_default_str();
+  app.add_option("--alpha", alpha, "Mass-proportional damping, 1/s");
+  app.add_option("--beta", beta, "Stiffness-proportional damping, s");
   app.add_option("--scenario", scenarioFile,
                  "Read scenario options from FILE, one 'name = value' per line (apps/support/scenario_file.h)");
 }
 
-std::vector<std::string> SimOptions::scenarioOptionNames() {
+std::string SimOptions::checkScenarioOption(const std::string& name, const std::string& value) {
   CLI::App app;
   SimOptions options;
   options.addScenarioTo(app);
-  std::vector<std::string> names;
+  std::string names;
   for (const CLI::Option* option : app.get_options())
-    for (const std::string& name : option->get_lnames())
-      if (name != "scenario" && name != "help") names.push_back(name);
-  return names;
+    for (const std::string& n : option->get_lnames())
+      if (n != "scenario" && n != "help") names += (names.empty() ? "" : ", ") + n;
+  if (name == "scenario" || name == "help" || !app.get_option_no_throw("--" + name))
+    return "'" + name + "' is not a scenario option (" + names + ")";
+  std::vector<std::string> token{"--" + name + "=" + value};
+  try {
+    app.parse(token);
+  } catch (const CLI::ParseError& e) {
+    return e.what();
+  }
+  return "";
 }
 
 void SimOptions::addTo(CLI::App& app) {
   addScenarioTo(app);
   app.add_option("-o,--output", output, "Write NAME.pvd with NAME_NNNNN.vtu frames and NAME.csv");
-  app.add_option("--every", every, "Write every k-th step")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--every", every, "Write every k-th step")->capture_default_str()->check(Positive);
   app.add_flag("--json", json, "Print one JSON summary");
 }
 

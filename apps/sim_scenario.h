@@ -36,8 +36,9 @@ struct SimOptions {
   // The scenario and what `sim` and `full` write: -o, --every, --json.
   void addTo(CLI::App& app);
   bool hasLoad() const;
-  // The option names addScenarioTo defines, without the dashes: what a scenario file may set.
-  static std::vector<std::string> scenarioOptionNames();
+  // "" when a scenario file may set `name = value` (an option addScenarioTo defines, with a value
+  // it takes), otherwise what is wrong.
+  static std::string checkScenarioOption(const std::string& name, const std::string& value);
 };
 
 // What a scenario drives: the runtime's instance or the full-space simulator.

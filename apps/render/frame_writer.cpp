@@ -20,13 +20,14 @@ bool endsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-// One %d, %Nd or %0Nd field and no other '%': the only patterns snprintf can fill safely.
+// One %d or %0Nd field (N from 1 to 9) and no other '%': patterns snprintf fills safely, into names
+// without spaces.
 bool isFramePattern(const std::string& path) {
   const size_t at = path.find('%');
   if (at == std::string::npos || path.find('%', at + 1) != std::string::npos) return false;
-  size_t i = at + 1;
-  while (i < path.size() && std::isdigit(static_cast<unsigned char>(path[i]))) ++i;
-  return i < path.size() && path[i] == 'd' && i - at <= 3;
+  const std::string field = path.substr(at + 1, 3);
+  return field.rfind("d", 0) == 0 ||
+         (field.size() == 3 && field[0] == '0' && field[1] >= '1' && field[1] <= '9' && field[2] == 'd');
 }
 
 } // namespace
@@ -59,12 +60,13 @@ struct FrameWriter::Gif {
         EGifPutExtensionTrailer(file) == GIF_ERROR)
       fail(path, "in the loop block", file->Error);
   }
-  void add(const std::string& path, const Image& image, int centiseconds) {
+  void add(const std::string& path, const Image& image, long centiseconds) {
     std::vector<GifColorType> table(256);
     std::vector<GifByteType> indices;
     if (!exactColours(image, table, indices)) quantize(path, image, table, indices);
     ColorMapObject* map = GifMakeMapObject(256, table.data());
-    GraphicsControlBlock control{DISPOSAL_UNSPECIFIED, false, centiseconds, NO_TRANSPARENT_COLOR};
+    GraphicsControlBlock control{DISPOSAL_UNSPECIFIED, false, static_cast<int>(std::min(centiseconds, 65535L)),
+                                 NO_TRANSPARENT_COLOR};
     GifByteType extension[4];
     EGifGCBToExtension(&control, extension);
     const bool ok = EGifPutExtension(file, GRAPHICS_EXT_FUNC_CODE, sizeof extension, extension) != GIF_ERROR &&
@@ -116,11 +118,10 @@ struct FrameWriter::Gif {
   }
 };
 
-FrameWriter::FrameWriter(const std::string& path, double frameSeconds)
-    : path_(path), centiseconds_(std::max(2, static_cast<int>(std::lround(100 * frameSeconds)))) {
+FrameWriter::FrameWriter(const std::string& path, double frameSeconds) : path_(path), frameSeconds_(frameSeconds) {
   if (path.find('%') != std::string::npos) {
     if (!isFramePattern(path) || !endsWith(path, ".png"))
-      throw std::runtime_error("-o " + path + ": an image sequence needs one %d-style field (such as %04d) and a .png name");
+      throw std::runtime_error("-o " + path + ": an image sequence needs one %d or %0Nd field (such as %04d) and a .png name");
     kind_ = Kind::Sequence;
   } else if (endsWith(path, ".gif")) {
     kind_ = Kind::Gif;
@@ -141,7 +142,7 @@ void FrameWriter::add(const Image& frame) {
     last_ = std::make_unique<Image>(frame);
     break;
   case Kind::Sequence: {
-    std::vector<char> name(path_.size() + 32);
+    std::vector<char> name(static_cast<size_t>(std::snprintf(nullptr, 0, path_.c_str(), frames_)) + 1);
     std::snprintf(name.data(), name.size(), path_.c_str(), frames_);
     writePng(name.data(), frame);
     break;
@@ -151,7 +152,12 @@ void FrameWriter::add(const Image& frame) {
       gif_ = std::make_unique<Gif>();
       gif_->start(path_, frame.width, frame.height);
     }
-    gif_->add(path_, frame, centiseconds_);
+    {
+      // Whole hundredths per frame, with the rounding carried over, so the animation keeps time.
+      const long end = std::lround(100 * frameSeconds_ * (frames_ + 1));
+      gif_->add(path_, frame, std::max(2L, end - shownCentiseconds_));
+      shownCentiseconds_ += std::max(2L, end - shownCentiseconds_);
+    }
     break;
   }
   ++frames_;

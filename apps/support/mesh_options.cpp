@@ -39,6 +39,19 @@ FixedVertexRequest FixedVertexOptions::resolved() const {
 
 std::vector<int> FixedVertexOptions::select(const CheckedMesh& mesh) const { return selectFixedVertices(mesh, resolved()); }
 
+const CLI::Validator Positive(
+    [](std::string& text) -> std::string {
+      size_t used = 0;
+      double value = 0;
+      try {
+        value = std::stod(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      return used == text.size() && value > 0 ? "" : "expected a positive number, not '" + text + "'";
+    },
+    "POSITIVE");
+
 int runTool(const std::string& tool, CLI::App& app, int argc, char** argv, const std::function<int()>& body,
             const ArgumentRewrite& rewrite) {
   std::vector<std::string> args(argv + 1, argv + argc);

@@ -32,6 +32,10 @@ struct FixedVertexOptions {
   std::vector<int> select(const CheckedMesh& mesh) const;
 };
 
+// A number above zero. CLI::PositiveNumber says "Value abc not in range 0 to 1.79e308" of a word;
+// this says what is expected.
+extern const CLI::Validator Positive;
+
 // Rewrites the command line (without the program name) before it is parsed; may throw.
 using ArgumentRewrite = std::function<std::vector<std::string>(const std::vector<std::string>&)>;
 

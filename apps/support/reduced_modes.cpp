@@ -1,5 +1,7 @@
 #include "apps/support/reduced_modes.h"
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
@@ -16,6 +18,16 @@ ReducedModes reducedModes(const qv_model* model) {
   qv_model_evaluate(model, q.data(), nullptr, nullptr, stiffness.data(), scratch.data());
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(stiffness);
   return {solver.eigenvalues(), solver.eigenvectors()};
+}
+
+Eigen::VectorXd withLargestDisplacement(const qv_model* model, const Eigen::VectorXd& q, double amplitude) {
+  qv_model_info info;
+  qv_model_get_info(model, &info);
+  std::vector<float> u(3 * static_cast<size_t>(info.vertex_count));
+  qv_model_displacements(model, q.data(), u.data());
+  double largest = 0;
+  for (size_t v = 0; v < u.size(); v += 3) largest = std::max(largest, std::hypot(double(u[v]), double(u[v + 1]), double(u[v + 2])));
+  return largest > 0 ? Eigen::VectorXd(q * (amplitude / largest)) : Eigen::VectorXd(Eigen::VectorXd::Zero(q.size()));
 }
 
 } // namespace quiver::app

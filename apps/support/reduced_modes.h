@@ -15,4 +15,7 @@ struct ReducedModes {
 
 ReducedModes reducedModes(const qv_model* model);
 
+// `q` scaled so that its largest vertex displacement |U_v q| is `amplitude` (zero stays zero).
+Eigen::VectorXd withLargestDisplacement(const qv_model* model, const Eigen::VectorXd& q, double amplitude);
+
 } // namespace quiver::app

@@ -8,19 +8,23 @@
 //   hold = 100
 //   gravity = true
 //
-// `--scenario FILE` stands for those options, at its place on the command line; options given
-// after it override the file's (the last value of an option wins).
+// `--scenario FILE` stands for those options, at its place on the command line; the same option
+// given later on the command line (or in a later file) overrides the file's.
+#include <functional>
 #include <string>
 #include <vector>
 
 namespace quiver::app {
 
-// The file's options as command-line tokens ("--twist=60"). `known` lists the option names a
-// scenario may set. Throws std::runtime_error naming the file, the line and what is wrong.
-std::vector<std::string> parseScenarioFile(const std::string& text, const std::string& fileName,
-                                           const std::vector<std::string>& known);
+// "" when `name = value` is a valid scenario option, otherwise what is wrong with it.
+using ScenarioCheck = std::function<std::string(const std::string& name, const std::string& value)>;
 
-// Replaces each `--scenario FILE` (or `--scenario=FILE`) in `args` by the file's options.
-std::vector<std::string> expandScenarioFiles(const std::vector<std::string>& args, const std::vector<std::string>& known);
+// The file's options as command-line tokens ("--twist=60"), each passed through `check`. Throws
+// std::runtime_error naming the file, the line and what is wrong.
+std::vector<std::string> parseScenarioFile(const std::string& text, const std::string& fileName, const ScenarioCheck& check);
+
+// Replaces each `--scenario FILE` (or `--scenario=FILE`) in `args` by the file's options, less
+// those that a later argument sets again.
+std::vector<std::string> expandScenarioFiles(const std::vector<std::string>& args, const ScenarioCheck& check);
 
 } // namespace quiver::app

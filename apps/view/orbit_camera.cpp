@@ -11,12 +11,13 @@ namespace {
 constexpr double kDegree = M_PI / 180;
 }
 
-OrbitCamera OrbitCamera::framing(const Eigen::Vector3d& boxMin, const Eigen::Vector3d& boxMax) {
+OrbitCamera OrbitCamera::framing(const Eigen::Vector3d& boxMin, const Eigen::Vector3d& boxMax, double aspect) {
   OrbitCamera c;
   c.target = 0.5 * (boxMin + boxMax);
   const double radius = std::max(0.5 * (boxMax - boxMin).norm(), 1e-9);
-  // The bounding sphere fits the vertical field of view, with a margin for deformation.
-  c.distance = 1.3 * radius / std::sin(0.5 * c.fieldOfView * kDegree);
+  // The bounding sphere fits the narrower of the two fields of view, with a margin for deformation.
+  const double vertical = 0.5 * c.fieldOfView * kDegree, horizontal = std::atan(aspect * std::tan(vertical));
+  c.distance = 1.3 * radius / std::sin(std::min(vertical, horizontal));
   return c;
 }
 

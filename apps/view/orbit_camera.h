@@ -15,8 +15,9 @@ struct OrbitCamera {
   double azimuth = 35, elevation = 25;  // degrees; the eye sits at (azimuth, elevation) around the target
   double fieldOfView = 40;              // vertical, degrees
 
-  // Frames a box: looks at its centre from far enough that the whole box is in view.
-  static OrbitCamera framing(const Eigen::Vector3d& boxMin, const Eigen::Vector3d& boxMax);
+  // Frames a box: looks at its centre from far enough that the whole box is in view of a window
+  // `aspect` (width / height) wide.
+  static OrbitCamera framing(const Eigen::Vector3d& boxMin, const Eigen::Vector3d& boxMax, double aspect);
 
   Eigen::Vector3d eye() const;
   Eigen::Matrix4f view() const;

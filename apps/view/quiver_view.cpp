@@ -21,7 +21,6 @@
 #include "apps/support/mesh_options.h"
 #include "apps/view/drag_script.h"
 #include "apps/view/orbit_camera.h"
-#include "apps/view/surface_pick.h"
 #include "apps/view/surface_view.h"
 #include "apps/view/view_session.h"
 
@@ -110,7 +109,8 @@ class Viewer {
 public:
   Viewer(const ViewOptions& o, const RuntimeModel& model)
       : o_(o), model_(model), session_(model, o.settings), triangles_(model.triangles()),
-        camera_(OrbitCamera::framing(Eigen::Vector3d(model.info().bbox_min), Eigen::Vector3d(model.info().bbox_max))),
+        camera_(OrbitCamera::framing(Eigen::Vector3d(model.info().bbox_min), Eigen::Vector3d(model.info().bbox_max),
+                                     double(o.size[0]) / o.size[1])),
         size_((Eigen::Vector3d(model.info().bbox_max) - Eigen::Vector3d(model.info().bbox_min)).norm()) {
     edited_ = session_.settings();
     if (!o.dragScript.empty()) script_ = DragScript::load(o.dragScript);
@@ -150,7 +150,8 @@ public:
     for (int frame = 0; !glfwWindowShouldClose(window.get()) && (o_.frames == 0 || frame < o_.frames); ++frame) {
       glfwPollEvents();
       const double now = glfwGetTime();
-      const double elapsed = o_.frames > 0 ? kScriptedFrameSeconds : std::min(now - last, 0.1);
+      // Uncapped: advance() takes at most kMaxStepsPerFrame and reports when it falls behind.
+      const double elapsed = o_.frames > 0 ? kScriptedFrameSeconds : now - last;
       last = now;
       int width = 0, height = 0, fbWidth = 0, fbHeight = 0;
       glfwGetWindowSize(window.get(), &width, &height);
@@ -215,17 +216,13 @@ private:
     }
     const Ray ray = camera_.ray(cursor.x, cursor.y, width, height);
     if (cursor.down && !mouseDown_) {
-      session_.positions(positions_);
-      if (const std::optional<SurfaceHit> hit = pickSurface(ray, positions_, triangles_)) {
-        dragPoint_ = hit->point;
-        dragNormal_ = (camera_.eye() - camera_.target).normalized();
-        session_.grab(hit->vertex, hit->point);
+      if (session_.press(ray, camera_.eye() - camera_.target)) {
         ++grabs_;
       } else if (script_) {
         std::fprintf(stderr, "quiver-view: warning: the scripted press at frame %d misses the model\n", frame);
       }
     } else if (cursor.down && session_.grabbing()) {
-      if (const auto target = intersectPlane(ray, dragPoint_, dragNormal_)) session_.grab(session_.grabbedVertex(), *target);
+      session_.drag(ray);
     } else if (cursor.down) {
       camera_.orbit(-0.3 * (cursor.x - lastX_), 0.3 * (cursor.y - lastY_));
     } else if (mouseDown_ && session_.grabbing()) {
@@ -326,7 +323,6 @@ private:
   std::optional<DragScript> script_;
   bool mouseDown_ = false;
   double lastX_ = 0, lastY_ = 0;
-  Eigen::Vector3d dragPoint_, dragNormal_;
   int grabs_ = 0;
   double stepsPerSecond_ = 0;
   std::deque<float> energy_;
@@ -351,13 +347,13 @@ int main(int argc, char** argv) {
   app.add_option("--elasticity", o.elasticity, "stvk, linear or warping")
       ->capture_default_str()
       ->check(CLI::IsMember({"stvk", "linear", "warping"}));
-  app.add_option("--dt", o.settings.timeStep, "Time step, s (default: the model's)")->check(CLI::PositiveNumber);
+  app.add_option("--dt", o.settings.timeStep, "Time step, s (default: the model's)")->check(Positive);
   app.add_option("--newton", o.settings.newtonIterations, "Newton iterations per implicit step")
       ->capture_default_str()
       ->check(CLI::Range(1, 20));
   app.add_flag("--gravity", o.settings.gravity, "Start with gravity, 9.81 m/s^2 along -z");
   app.add_option("--frames", o.frames, "Run this many frames (1/60 s of simulation each), then exit")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive);
   app.add_option("--screenshot", o.screenshot, "With --frames: save the last frame as a PNG");
   app.add_option("--drag-script", o.dragScript, "Drive the mouse from a script (apps/view/drag_script.h)");
   app.add_flag("--no-panel", o.noPanel, "Hide the control panel");

@@ -97,6 +97,24 @@ int ViewSession::advance(double seconds) {
   return taken;
 }
 
+bool ViewSession::press(const Ray& ray, const Eigen::Vector3d& towardViewer) {
+  std::vector<float> x;
+  positions(x);
+  const std::optional<SurfaceHit> hit = pickSurface(ray, x, model_.triangles());
+  if (!hit) return false;
+  const int v = hit->vertex;
+  dragPoint_ = hit->point;
+  dragNormal_ = towardViewer.normalized();
+  dragOffset_ = Eigen::Vector3d(x[3 * v], x[3 * v + 1], x[3 * v + 2]) - hit->point;
+  grab(v, hit->point + dragOffset_);
+  return true;
+}
+
+void ViewSession::drag(const Ray& ray) {
+  if (grabbed_ < 0) return;
+  if (const std::optional<Eigen::Vector3d> at = intersectPlane(ray, dragPoint_, dragNormal_)) grab(grabbed_, *at + dragOffset_);
+}
+
 void ViewSession::grab(int vertex, const Eigen::Vector3d& target) {
   grabbed_ = vertex;
   grabTarget_ = target;
@@ -119,12 +137,9 @@ void ViewSession::showMode(ModeKind kind, int index, double amplitude) {
   if (kind == ModeKind::None) return;
   const int r = model_.info().r;
   if (index < 0 || index >= r) throw std::out_of_range("mode " + std::to_string(index) + " of " + std::to_string(r));
-  Eigen::VectorXd q = kind == ModeKind::LinearMode ? Eigen::VectorXd(modes_.vectors.col(index)) : Eigen::VectorXd::Unit(r, index);
-  std::vector<float> u(3 * static_cast<size_t>(model_.info().vertex_count));
-  qv_model_displacements(model_.get(), q.data(), u.data());
-  float largest = 0;
-  for (float x : u) largest = std::max(largest, std::abs(x));
-  modeShape_ = largest > 0 ? Eigen::VectorXd(q * (amplitude / largest)) : Eigen::VectorXd::Zero(r);
+  const Eigen::VectorXd q =
+      kind == ModeKind::LinearMode ? Eigen::VectorXd(modes_.vectors.col(index)) : Eigen::VectorXd(Eigen::VectorXd::Unit(r, index));
+  modeShape_ = withLargestDisplacement(model_.get(), q, amplitude);
 }
 
 void ViewSession::positions(std::vector<float>& out) const {

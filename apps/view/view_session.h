@@ -10,6 +10,7 @@
 
 #include "apps/support/reduced_modes.h"
 #include "apps/support/runtime_model.h"
+#include "apps/view/surface_pick.h"
 
 namespace quiver::app {
 
@@ -34,10 +35,11 @@ public:
   static constexpr double kModePeriod = 1.5;    // s per oscillation in the mode browser, whatever the frequency
 
   ViewSession(const RuntimeModel& model, const ViewSettings& settings);
+  ViewSession(RuntimeModel&&, const ViewSettings&) = delete;  // the session keeps a reference
 
   const RuntimeModel& model() const { return model_; }
   const ViewSettings& settings() const { return settings_; }
-  const qv_instance_config& config() const { return instance_->config(); }
+  qv_instance_config config() const { return instance_->config(); }
   // Takes new settings; a new integrator, step, damping or elasticity makes a new instance that
   // continues from the current displacement and velocity. Throws if the runtime refuses them (the
   // old settings stay).
@@ -49,7 +51,12 @@ public:
   int advance(double seconds);
   bool behindRealTime() const { return behind_; }
 
-  // The mouse spring: pulls `vertex` toward `target`.
+  // The mouse: a press on the surface grabs the vertex nearest the hit on a spring. The spring's
+  // target keeps the vertex's offset from the hit point (a press held still pulls nothing) and
+  // follows the cursor ray in the plane through the hit point facing `towardViewer`.
+  bool press(const Ray& ray, const Eigen::Vector3d& towardViewer);  // false: the ray misses the model
+  void drag(const Ray& ray);
+  // The spring itself: pulls `vertex` toward `target`.
   void grab(int vertex, const Eigen::Vector3d& target);
   void release();
   bool grabbing() const { return grabbed_ >= 0; }
@@ -81,6 +88,7 @@ private:
   bool behind_ = false;
   int grabbed_ = -1;
   Eigen::Vector3d grabTarget_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d dragPoint_, dragNormal_, dragOffset_;  // the press: plane point and normal, vertex - hit
   long steps_ = 0;
   int resets_ = 0;
   double stepMicros_ = 0;

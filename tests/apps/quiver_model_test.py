@@ -203,7 +203,11 @@ class QuiverRender(OnTheBakedModel):
             self.skipTest("python3-pil not installed: cannot decode the GIF")
         with Image.open(self.render(name, *args)[0]) as gif:
             self.assertEqual(gif.info.get("loop"), 0)  # loops forever
-            return [np.asarray(f.convert("RGB"), dtype=float) / 255 for f in ImageSequence.Iterator(gif)], gif.info
+            frames, durations = [], []
+            for f in ImageSequence.Iterator(gif):
+                frames.append(np.asarray(f.convert("RGB"), dtype=float) / 255)
+                durations.append(f.info["duration"])
+            return frames, {"durations": durations}
 
     def assertFramed(self, image):
         covered = (image < 0.99).any(axis=2).mean()
@@ -259,6 +263,8 @@ class QuiverRender(OnTheBakedModel):
         self.assertEqual(frames[0].shape, (100, 160, 3))
         self.assertFramed(frames[0])
         self.assertMoved(frames[5], frames[0])  # pulled at step 20
+        # Played at simulation speed: 4 steps of 1/60 s a frame is 6.67 hundredths, so delays of 6 and 7 add up.
+        self.assertEqual(sum(info["durations"]), 10 * round(100 * len(frames) * 4 / 60))
         modes, _ = self.frames("modes.gif", "--size", "200,200", "--modes", "4")
         self.assertEqual(len(modes), 30)  # one oscillation
         self.assertMoved(modes[7], modes[0])  # a quarter period: at full amplitude, from rest
@@ -273,7 +279,11 @@ class QuiverRender(OnTheBakedModel):
                                     ("x.png", ["--force", "0,0,-1", "--group", "x<-5"], "selects no vertex"),
                                     ("x.png", ["--modes", "3", "--gravity"], "drop the scenario"),
                                     ("x.jpg", ["--modes", "3"], ".gif animation"),
-                                    ("x_%d_%d.png", [], "one %d-style field"),
+                                    ("x_%d_%d.png", [], "one %d or %0Nd field"),
+                                    ("x_%5d.png", [], "one %d or %0Nd field"),  # would pad with spaces
+                                    ("x.png", ["--modes", "2", "--amplitude", "nan"], "--amplitude"),
+                                    ("x.png", ["--modes", "-3"], "--modes"),
+                                    ("x.png", ["--force", "1,2"], "--force"),
                                     ("x.gif", [], "nothing moves")):
             with self.subTest(args=args):
                 _, p = self.render(name, *args, ok=False)

@@ -44,9 +44,9 @@ class QuiverView(unittest.TestCase):
             command = [XVFB_RUN, "-a", "-s", "-screen 0 1280x1024x24", *command]
         return subprocess.run(command, capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
 
-    def shot(self, name, *args):
+    def shot(self, name, *args, frames=90):
         path = os.path.join(self.tmp.name, name)
-        p = self.view("--frames", 90, "--screenshot", path, *args)
+        p = self.view("--frames", frames, "--screenshot", path, *args)
         self.assertEqual(p.returncode, 0, p.stderr)
         import matplotlib.image
         image = matplotlib.image.imread(path)[:, :, :3]
@@ -69,6 +69,10 @@ class QuiverView(unittest.TestCase):
         self.assertIn("0 resets", out)
         changed = (np.abs(dragged - rest).max(axis=2) > 0.1).mean()
         self.assertGreater(changed, 0.01, "the screenshot after the drag should differ from the rest pose")
+        # While held (frame 60), the model reaches lower than at rest: the script drags down.
+        held, _ = self.shot("held.png", "--no-panel", "--drag-script", self.script, frames=60)
+        lowest = lambda image: np.nonzero(self.model_pixels(image).any(axis=1))[0].max()
+        self.assertGreater(lowest(held), lowest(rest) + 10)
 
     def test_panel_is_drawn(self):
         bare, _ = self.shot("bare.png", "--no-panel")

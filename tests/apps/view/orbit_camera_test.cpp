@@ -10,7 +10,7 @@ namespace {
 // A point projected by the GL matrices (what the screen shows) lies on the ray cast back through
 // that pixel (what picking uses): the two are computed independently.
 TEST(OrbitCamera, RayThroughAProjectedPointPassesThroughIt) {
-  OrbitCamera camera = OrbitCamera::framing(Eigen::Vector3d(0, -0.1, -0.2), Eigen::Vector3d(1, 0.1, 0.3));
+  OrbitCamera camera = OrbitCamera::framing(Eigen::Vector3d(0, -0.1, -0.2), Eigen::Vector3d(1, 0.1, 0.3), 16.0 / 9);
   camera.orbit(20, -10);
   const double width = 1280, height = 720;
   const Eigen::Matrix4f m = camera.projection(width / height) * camera.view();
@@ -38,16 +38,21 @@ TEST(OrbitCamera, OrbitNeverTurnsOverTheTopAndZoomStaysPositive) {
   EXPECT_GT(camera.distance, 0);
 }
 
-TEST(OrbitCamera, FramingKeepsTheWholeBoxInView) {
+TEST(OrbitCamera, FramingKeepsTheWholeBoxInViewOfTallAndWideWindows) {
   const Eigen::Vector3d lo(-2, 0, 0), hi(3, 0.5, 0.25);
-  const OrbitCamera camera = OrbitCamera::framing(lo, hi);
-  const Eigen::Matrix4f m = camera.projection(1.0) * camera.view();
-  for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector4f p((corner & 1 ? hi : lo).x(), (corner & 2 ? hi : lo).y(), (corner & 4 ? hi : lo).z(), 1);
-    const Eigen::Vector4f clip = m * p;
-    EXPECT_LT(std::abs(clip.x() / clip.w()), 1);
-    EXPECT_LT(std::abs(clip.y() / clip.w()), 1);
-    EXPECT_LT(std::abs(clip.z() / clip.w()), 1) << "between the near and far planes";
+  for (const double aspect : {0.2, 1.0, 5.0}) {
+    const OrbitCamera camera = OrbitCamera::framing(lo, hi, aspect);
+    const Eigen::Matrix4f m = camera.projection(aspect) * camera.view();
+    double widest = 0;
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector4f p((corner & 1 ? hi : lo).x(), (corner & 2 ? hi : lo).y(), (corner & 4 ? hi : lo).z(), 1);
+      const Eigen::Vector4f clip = m * p;
+      EXPECT_LT(std::abs(clip.x() / clip.w()), 1) << "aspect " << aspect;
+      EXPECT_LT(std::abs(clip.y() / clip.w()), 1) << "aspect " << aspect;
+      EXPECT_LT(std::abs(clip.z() / clip.w()), 1) << "between the near and far planes";
+      widest = std::max({widest, double(std::abs(clip.x() / clip.w())), double(std::abs(clip.y() / clip.w()))});
+    }
+    EXPECT_GT(widest, 0.3) << "and not lost in the middle; aspect " << aspect;
   }
 }
 

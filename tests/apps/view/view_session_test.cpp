@@ -56,6 +56,33 @@ TEST_F(ViewSessionTest, TheSpringPullsTheGrabbedVertexTowardItsTarget) {
   EXPECT_EQ(session.resets(), 0);
 }
 
+TEST_F(ViewSessionTest, APressHeldStillPullsNothingAndADragPullsAlongTheRay) {
+  ViewSession session(model, ViewSettings{});
+  const qv_model_info& info = model.info();
+  // Straight down onto the top face near the free end (the beam is fixed at x = min).
+  const Eigen::Vector3d above(0.9 * info.bbox_max[0] + 0.1 * info.bbox_min[0], 0.3 * info.bbox_max[1], info.bbox_max[2] + 1);
+  const Ray down{above, {0, 0, -1}};
+  ASSERT_TRUE(session.press(down, {0, 0, 1}));
+  EXPECT_FALSE(session.press(Ray{above, {0, 0, 1}}, {0, 0, 1})) << "up, away from the beam";
+  for (int frame = 0; frame < 60; ++frame) {
+    session.drag(down);
+    session.advance(1.0 / 60);
+  }
+  EXPECT_LT(session.kineticEnergy() + session.elasticEnergy(), 1e-12) << "the spring starts at the grabbed vertex";
+  // The cursor 2 cm toward -y: the target moves 2 cm in the plane z = top, and the vertex follows.
+  std::vector<float> before, after;
+  session.positions(before);
+  const Ray aside{above - Eigen::Vector3d(0, 0.02, 0), {0, 0, -1}};
+  for (int frame = 0; frame < 30; ++frame) {
+    session.drag(aside);
+    session.advance(1.0 / 60);
+  }
+  const int v = session.grabbedVertex();
+  EXPECT_NEAR((session.grabTarget() - Eigen::Vector3d(before[3 * v], before[3 * v + 1] - 0.02, before[3 * v + 2])).norm(), 0, 1e-12);
+  session.positions(after);
+  EXPECT_LT(after[3 * v + 1], before[3 * v + 1] - 0.002);
+}
+
 TEST_F(ViewSessionTest, SameStepsAsTheRuntimeAlone) {
   ViewSettings settings;
   settings.gravity = true;
@@ -132,7 +159,8 @@ TEST_F(ViewSessionTest, ModesAreEigenvectorsOfTheReducedStiffnessShownAtTheirAmp
     std::vector<float> x;
     session.positions(x);
     double most = 0;
-    for (size_t k = 0; k < x.size(); ++k) most = std::max(most, std::abs(x[k] - rest[k]));
+    for (size_t k = 0; k < x.size(); k += 3)
+      most = std::max(most, std::hypot(x[k] - rest[k], x[k + 1] - rest[k + 1], x[k + 2] - rest[k + 2]));
     return most;
   };
   EXPECT_LT(largest(), 1e-6) << "starts at rest (float positions)";
