@@ -250,11 +250,18 @@ class QuiverRender(OnTheBakedModel):
         j = json.loads(subprocess.run([QUIVER, "sim", self.model, "--scenario", scenario, "--json"], capture_output=True,
                                       text=True, check=True).stdout)
         self.assertEqual(j["steps"], 60)
-        with open(scenario, "a") as f:
-            f.write("twirl = 3\n")
-        _, p = self.render("never.png", "--scenario", scenario, ok=False)
-        self.assertEqual(p.returncode, 1)
-        self.assertIn("twist.scenario:6: 'twirl' is not a scenario option", p.stderr)
+        for line, message in (("twirl = 3", "twist.scenario:6: 'twirl' is not a scenario option (steps, hold,"),
+                              ("steps = many", "twist.scenario:6: --steps: expected a positive number, not 'many'"),
+                              ("force = 0,-1", "twist.scenario:6: --force"),
+                              ("scenario = twist.scenario", "'scenario' is not a scenario option")):
+            with self.subTest(line=line):
+                broken = os.path.join(self.tmp.name, "broken", "twist.scenario")
+                os.makedirs(os.path.dirname(broken), exist_ok=True)
+                with open(scenario) as f, open(broken, "w") as g:
+                    g.write(f.read() + line + "\n")
+                _, p = self.render("never.png", "--scenario", broken, ok=False)
+                self.assertEqual(p.returncode, 1)
+                self.assertIn(message, p.stderr)
 
     def test_animations(self):
         frames, info = self.frames("pull.gif", "--size", "160,100", "--force", "0,0,-20", "--hold", "20", "--steps",
