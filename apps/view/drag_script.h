@@ -1,5 +1,5 @@
 #pragma once
-// A scripted mouse for the viewer (`quiver-view --drag-script FILE`), so that tests and recordings
+// A scripted mouse for the viewer (`quiver-view --drag-script FILE`; it clicks the panel too), so that tests and recordings
 // drag the model the same way every run. One event per line, frames in order, '#' starts a comment:
 //
 //   # frame  action   x     y      (x, y: fractions of the window, from its top-left corner)

@@ -159,8 +159,13 @@ public:
 
       ImGui_ImplOpenGL3_NewFrame();
       ImGui_ImplGlfw_NewFrame();
+      const ScriptedCursor cursor = readCursor(window.get(), frame, width, height);
+      if (script_) {  // the scripted mouse clicks the panel too
+        ImGui::GetIO().MousePos = ImVec2(static_cast<float>(cursor.x), static_cast<float>(cursor.y));
+        ImGui::GetIO().MouseDown[0] = cursor.down;
+      }
       ImGui::NewFrame();
-      handleMouse(window.get(), frame, width, height);
+      handleMouse(cursor, frame, width, height);
       rateSteps += session_.advance(elapsed);
       // Steps per wall-clock second, over the last half second (a running value before the first).
       if (now - rateStart > 0.05) stepsPerSecond_ = rateSteps / (now - rateStart);
@@ -200,10 +205,8 @@ public:
   }
 
 private:
-  // One cursor, from the script or the mouse: press picks a surface point (drag it) or the
-  // background (orbit); holding moves the spring's target in the plane through the picked point
-  // facing the camera; release lets go.
-  void handleMouse(GLFWwindow* window, int frame, int width, int height) {
+  // The cursor in window pixels and the left button, from the script or the mouse.
+  ScriptedCursor readCursor(GLFWwindow* window, int frame, int width, int height) const {
     ScriptedCursor cursor;
     if (script_) {
       cursor = script_->at(frame);
@@ -212,8 +215,15 @@ private:
     } else {
       glfwGetCursorPos(window, &cursor.x, &cursor.y);
       cursor.down = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
-      if (cursor.down && !mouseDown_ && ImGui::GetIO().WantCaptureMouse) cursor.down = false;  // a click on the panel
     }
+    return cursor;
+  }
+
+  // A press on the panel is the panel's. Elsewhere it picks a surface point (drag it) or the
+  // background (orbit); holding moves the spring's target in the plane through the picked point
+  // facing the camera; release lets go.
+  void handleMouse(ScriptedCursor cursor, int frame, int width, int height) {
+    if (cursor.down && !mouseDown_ && ImGui::GetIO().WantCaptureMouse) cursor.down = false;
     const Ray ray = camera_.ray(cursor.x, cursor.y, width, height);
     if (cursor.down && !mouseDown_) {
       if (session_.press(ray, camera_.eye() - camera_.target)) {

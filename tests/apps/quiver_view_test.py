@@ -39,7 +39,7 @@ class QuiverView(unittest.TestCase):
         cls.tmp.cleanup()
 
     def view(self, *args, display=True):
-        command = [VIEW, MODEL, "--size", SIZE, *map(str, args)]
+        command = [VIEW, MODEL, *([] if "--size" in args else ["--size", SIZE]), *map(str, args)]
         if display:
             command = [XVFB_RUN, "-a", "-s", "-screen 0 1280x1024x24", *command]
         return subprocess.run(command, capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
@@ -49,9 +49,7 @@ class QuiverView(unittest.TestCase):
         p = self.view("--frames", frames, "--screenshot", path, *args)
         self.assertEqual(p.returncode, 0, p.stderr)
         import matplotlib.image
-        image = matplotlib.image.imread(path)[:, :, :3]
-        self.assertEqual(image.shape, (400, 640, 3))
-        return image, p.stdout
+        return matplotlib.image.imread(path)[:, :, :3], p.stdout
 
     @staticmethod
     def model_pixels(image):
@@ -60,6 +58,7 @@ class QuiverView(unittest.TestCase):
 
     def test_drag_moves_the_model_and_it_rings_after_release(self):
         rest, out = self.shot("rest.png", "--no-panel")
+        self.assertEqual(rest.shape, (400, 640, 3))
         covered = self.model_pixels(rest).mean()
         self.assertGreater(covered, 0.02)  # not blank
         self.assertLess(covered, 0.9)  # the camera frames it
@@ -81,6 +80,19 @@ class QuiverView(unittest.TestCase):
         self.assertGreater(bare[corner].mean(), 0.8)  # light background
         self.assertLess(panel[corner].mean(), 0.5)  # the dark panel
         self.assertGreater(len(np.unique(panel[corner].reshape(-1, 3), axis=0)), 10)  # text and widgets, not a flat box
+
+    def test_a_scripted_click_on_the_panel_turns_gravity_on(self):
+        # The panel opens at the top left with ImGui 1.86's default font: the gravity checkbox sits at
+        # pixel (27, 313) of a 1280 x 800 window. The click is the panel's: no grab.
+        click = os.path.join(self.tmp.name, "click.txt")
+        with open(click, "w") as f:
+            f.write("10 press 0.021 0.391\n12 release\n")
+        plain, _ = self.shot("no_click.png", "--size", "1280,800")
+        fallen, out = self.shot("gravity.png", "--size", "1280,800", "--drag-script", click)
+        self.assertIn("0 grabs", out)
+        right = (slice(None), slice(450, None))  # clear of the panel
+        lowest = lambda image: np.nonzero(self.model_pixels(image[right]).any(axis=1))[0].max()
+        self.assertGreater(lowest(fallen), lowest(plain) + 20, "the beam should sag once gravity is on")
 
     def test_mode_browser_shows_a_mode(self):
         rest, _ = self.shot("rest_for_mode.png", "--no-panel")
