@@ -1,6 +1,7 @@
 #pragma once
-// A scripted mouse for the viewer (`quiver-view --drag-script FILE`; it clicks the panel too), so that tests and recordings
-// drag the model the same way every run. One event per line, frames in order, '#' starts a comment:
+// A scripted mouse for the viewer (`quiver-view --drag-script FILE`), on the model and the panel
+// alike, so that tests and recordings act the same way every run. One event per line, frames in
+// order, '#' starts a comment:
 //
 //   # frame  action   x     y      (x, y: fractions of the window, from its top-left corner)
 //   10       press    0.80  0.45
