@@ -3,30 +3,14 @@
 #include <cstring>
 #include <new>
 
+#include "block_carver.h"
 #include "dense_solve.h"
 #include "formats/model/modal_warping.h"
 #include "quiver/quiver.h"
 
 namespace {
 
-// Walks the instance's block once to size it and once to place the arrays, so the two can
-// never disagree.
-class Carver {
-public:
-  explicit Carver(char* base) : base_(base) {}
-  template <class T>
-  T* take(size_t count) {
-    offset_ = (offset_ + 63) & ~size_t(63);
-    T* p = base_ ? reinterpret_cast<T*>(base_ + offset_) : nullptr;
-    offset_ += count * sizeof(T);
-    return p;
-  }
-  size_t size() const { return (offset_ + 63) & ~size_t(63); }
-
-private:
-  char* base_;
-  size_t offset_ = 0;
-};
+using quiver::rt::BlockCarver;
 
 double basisEntry(const qv_model* m, size_t row, size_t j) {
   const size_t r = static_cast<size_t>(m->info.r);
@@ -251,7 +235,7 @@ bool validConfig(const qv_model* model, const qv_instance_config* c) {
 }
 
 size_t instanceBytes(const qv_model* model, const qv_instance_config* config) {
-  Carver c(nullptr);
+  BlockCarver c(nullptr);
   c.take<qv_instance>(1);
   qv_instance probe{};
   probe.r = model->info.r;
@@ -287,7 +271,7 @@ double largestRestEigenvalue(qv_instance* s) {
 }
 
 qv_instance* construct(const qv_model* model, const qv_instance_config* config, char* block) {
-  Carver c(block);
+  BlockCarver c(block);
   qv_instance* s = new (c.take<qv_instance>(1)) qv_instance{};
   s->model = model;
   s->config = *config;

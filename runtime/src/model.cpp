@@ -7,6 +7,7 @@
 
 #include "formats/model/qvr.h"
 #include "quiver/quiver.h"
+#include "block_carver.h"
 #include "reduced_polynomial.h"
 
 struct qv_model {
@@ -35,32 +36,25 @@ void report(char* message, size_t size, const std::string& text) {
   if (message && size > 0) std::snprintf(message, size, "%s", text.c_str());
 }
 
-size_t roundUp(size_t n) { return (n + 63) & ~size_t(63); }
-
-// Copies `count` items of T to the next 64-byte boundary of the block.
-template <class T>
-const T* place(char*& cursor, const T* source, size_t count) {
-  T* target = reinterpret_cast<T*>(cursor);
-  if (count) std::memcpy(target, source, count * sizeof(T));
-  cursor += roundUp(count * sizeof(T));
-  return target;
-}
-
-qv_result build(const quiver::ModelView& view, const qv_model_config& config, const qv_allocator& allocator,
-                qv_model** out) {
-  const bool single = config.coefficient_precision == 32;
+// Lays the model out in `block` (null: only measures it) and, when placing, copies the view in.
+// Returns the block's size.
+size_t layOut(const quiver::ModelView& view, bool single, const qv_allocator& allocator, char* block) {
   const quiver::ModelInfo& in = view.info;
   const size_t r = in.r, n = in.vertexCount;
-  const size_t basisBytes = 3 * n * r * (in.basisPrecision == 32 ? sizeof(float) : sizeof(double));
-  const size_t bytes = roundUp(sizeof(qv_model)) +
-                       roundUp(quiver::rt::ReducedPolynomial::storageBytes(in.r, single)) +
-                       roundUp(basisBytes) + roundUp(3 * n * sizeof(double)) +
-                       roundUp(3 * size_t(in.triangleCount) * sizeof(unsigned)) + roundUp(n * sizeof(unsigned)) +
-                       roundUp(3 * r * sizeof(double)) + roundUp(size_t(in.eigenvalueCount) * sizeof(double)) +
-                       (view.rotations ? roundUp(3 * n * r * sizeof(double)) : 0);
-  char* block = static_cast<char*>(allocator.allocate(bytes, 64, allocator.user));
-  if (!block) return QV_ERROR_OUT_OF_MEMORY;
-  qv_model* m = new (block) qv_model{};
+  quiver::rt::BlockCarver c(block);
+  qv_model* m = c.take<qv_model>(1);
+  char* polynomial = c.take<char>(quiver::rt::ReducedPolynomial::storageBytes(in.r, single));
+  float* basis32 = view.basis32 ? c.take<float>(3 * n * r) : nullptr;
+  double* basis64 = view.basis32 ? nullptr : c.take<double>(3 * n * r);
+  double* rest = c.take<double>(3 * n);
+  unsigned* triangles = c.take<unsigned>(3 * size_t(in.triangleCount));
+  unsigned* vertexMap = c.take<unsigned>(n);
+  double* gravity = c.take<double>(3 * r);
+  double* eigenvalues = c.take<double>(in.eigenvalueCount);
+  double* rotations = view.rotations ? c.take<double>(3 * n * r) : nullptr;
+  if (!block) return c.size();
+
+  m = new (m) qv_model{};
   m->allocator = allocator;
   m->info = qv_model_info{static_cast<int>(in.r), static_cast<int>(in.vertexCount), static_cast<int>(in.tetCount),
                           static_cast<int>(in.triangleCount), static_cast<int>(in.fileVertexCount),
@@ -68,20 +62,30 @@ qv_result build(const quiver::ModelView& view, const qv_model_config& config, co
                           static_cast<int>(in.materialIsUniform), view.rotations ? 1 : 0, in.youngsModulus, in.poissonRatio, in.density,
                           in.totalMass, in.rayleighAlpha, in.rayleighBeta, in.timeStep,
                           {in.bboxMin[0], in.bboxMin[1], in.bboxMin[2]}, {in.bboxMax[0], in.bboxMax[1], in.bboxMax[2]}};
-  char* cursor = block + roundUp(sizeof(qv_model));
-  m->polynomial.build(in.r, view.energy, single, cursor);
-  cursor += roundUp(quiver::rt::ReducedPolynomial::storageBytes(in.r, single));
-  if (view.basis32)
-    m->basis32 = place(cursor, view.basis32, 3 * n * r);
-  else
-    m->basis64 = place(cursor, view.basis64, 3 * n * r);
-  m->rest = place(cursor, view.restPositions, 3 * n);
-  m->triangles = place(cursor, reinterpret_cast<const unsigned*>(view.triangles), 3 * size_t(in.triangleCount));
-  m->vertexMap = place(cursor, reinterpret_cast<const unsigned*>(view.vertexMap), n);
-  m->gravity = place(cursor, view.gravity, 3 * r);
-  m->eigenvalues = place(cursor, view.eigenvalues, in.eigenvalueCount);
-  m->rotations = view.rotations ? place(cursor, view.rotations, 3 * n * r) : nullptr;
-  *out = m;
+  m->polynomial.build(in.r, view.energy, single, polynomial);
+  const auto copy = [](auto* target, const auto* source, size_t count) {
+    if (count) std::memcpy(target, source, count * sizeof(*target));
+    return target;
+  };
+  m->basis32 = view.basis32 ? copy(basis32, view.basis32, 3 * n * r) : nullptr;
+  m->basis64 = view.basis32 ? nullptr : copy(basis64, view.basis64, 3 * n * r);
+  m->rest = copy(rest, view.restPositions, 3 * n);
+  m->triangles = copy(triangles, reinterpret_cast<const unsigned*>(view.triangles), 3 * size_t(in.triangleCount));
+  m->vertexMap = copy(vertexMap, reinterpret_cast<const unsigned*>(view.vertexMap), n);
+  m->gravity = copy(gravity, view.gravity, 3 * r);
+  m->eigenvalues = copy(eigenvalues, view.eigenvalues, in.eigenvalueCount);
+  m->rotations = view.rotations ? copy(rotations, view.rotations, 3 * n * r) : nullptr;
+  return c.size();
+}
+
+qv_result build(const quiver::ModelView& view, const qv_model_config& config, const qv_allocator& allocator,
+                qv_model** out) {
+  const bool single = config.coefficient_precision == 32;
+  const size_t bytes = layOut(view, single, allocator, nullptr);
+  char* block = static_cast<char*>(allocator.allocate(bytes, 64, allocator.user));
+  if (!block) return QV_ERROR_OUT_OF_MEMORY;
+  layOut(view, single, allocator, block);
+  *out = reinterpret_cast<qv_model*>(block);
   return QV_OK;
 }
 

@@ -46,8 +46,6 @@ size_t packedCount(size_t pairs) {
   return total;
 }
 
-size_t roundUp64(size_t bytes) { return (bytes + 63) & ~size_t(63); }
-
 // y[s] += Q[p][s] x[p] for s > p and y[p] += sum_s Q[p][s] x[s]: one pass over row p of the upper
 // triangle does both halves of the symmetric product (the stored diagonal is halved). Rows come
 // four at a time: rows of one 8-aligned group start at the same column and have the same length,
@@ -108,10 +106,26 @@ QV_HOT void sumOfRows(const double* T, int r, size_t n, const double* q, double*
 
 } // namespace
 
+ReducedPolynomial::Arrays ReducedPolynomial::carve(BlockCarver& c, bool single) const {
+  Arrays a{};
+  a.k2 = c.take<double>(pairs_);
+  a.t = c.take<double>(static_cast<size_t>(r_) * pairs_);
+  a.rowStart = c.take<size_t>(pairs_);
+  a.rowOffset = c.take<size_t>(pairs_);
+  if (single)
+    a.q32 = c.take<float>(packedCount(pairs_));
+  else
+    a.q64 = c.take<double>(packedCount(pairs_));
+  return a;
+}
+
 size_t ReducedPolynomial::storageBytes(int r, bool single) {
-  const size_t pairs = monomialCount2(r);
-  return roundUp64(pairs * sizeof(double)) + roundUp64(static_cast<size_t>(r) * pairs * sizeof(double)) +
-         2 * roundUp64(pairs * sizeof(size_t)) + roundUp64(packedCount(pairs) * (single ? sizeof(float) : sizeof(double)));
+  ReducedPolynomial measured;
+  measured.r_ = r;
+  measured.pairs_ = monomialCount2(r);
+  BlockCarver c(nullptr);
+  measured.carve(c, single);
+  return c.size();
 }
 
 size_t ReducedPolynomial::scratchSize(int r) { return monomialCount2(r) * 3 + static_cast<size_t>(r); }
@@ -120,18 +134,14 @@ void ReducedPolynomial::build(int r, const double* c, bool single, void* storage
   r_ = r;
   pairs_ = monomialCount2(r);
   const size_t P = pairs_;
-  std::memset(storage, 0, storageBytes(r, single));
-  char* cursor = static_cast<char*>(storage);
-  auto take = [&](size_t bytes) {
-    char* p = cursor;
-    cursor += roundUp64(bytes);
-    return p;
-  };
-  double* k2 = reinterpret_cast<double*>(take(P * sizeof(double)));
-  double* t = reinterpret_cast<double*>(take(static_cast<size_t>(r) * P * sizeof(double)));
-  size_t* rowStart = reinterpret_cast<size_t*>(take(P * sizeof(size_t)));
-  size_t* rowOffset = reinterpret_cast<size_t*>(take(P * sizeof(size_t)));
-  void* Q = take(packedCount(P) * (single ? sizeof(float) : sizeof(double)));
+  BlockCarver carver(static_cast<char*>(storage));
+  const Arrays arrays = carve(carver, single);
+  std::memset(storage, 0, carver.size());
+  double* k2 = arrays.k2;
+  double* t = arrays.t;
+  size_t* rowStart = arrays.rowStart;
+  size_t* rowOffset = arrays.rowOffset;
+  void* Q = single ? static_cast<void*>(arrays.q32) : static_cast<void*>(arrays.q64);
   for (size_t p = 0, offset = 0; p < P; ++p) {
     rowStart[p] = align8(p);
     rowOffset[p] = offset;
@@ -180,12 +190,12 @@ void ReducedPolynomial::build(int r, const double* c, bool single, void* storage
               setQ(pairIndex(r, idx[x], idx[y]), pairIndex(r, rest[0], rest[1]), value);
             }
         }
-  k2_ = k2;
-  t_ = t;
-  rowStart_ = rowStart;
-  rowOffset_ = rowOffset;
-  q64_ = single ? nullptr : static_cast<const double*>(Q);
-  q32_ = single ? static_cast<const float*>(Q) : nullptr;
+  k2_ = arrays.k2;
+  t_ = arrays.t;
+  rowStart_ = arrays.rowStart;
+  rowOffset_ = arrays.rowOffset;
+  q64_ = arrays.q64;
+  q32_ = arrays.q32;
 }
 
 void ReducedPolynomial::evaluate(const double* q, double* energy, double* force, double* stiffness,

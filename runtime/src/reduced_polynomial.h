@@ -13,6 +13,8 @@
 //   R(q) = (K_2 + K_3(q)/2 + K_4(q)/3) q,   E(q) = q^T (K_2/2 + K_3(q)/6 + K_4(q)/12) q.
 #include <cstddef>
 
+#include "block_carver.h"
+
 namespace quiver::rt {
 
 class ReducedPolynomial {
@@ -33,6 +35,17 @@ public:
   bool single() const { return q32_ != nullptr; }
 
 private:
+  struct Arrays {
+    double* k2;
+    double* t;
+    size_t* rowStart;
+    size_t* rowOffset;
+    double* q64;
+    float* q32;
+  };
+  // Takes the arrays for r_ from `c` (null pointers while it measures).
+  Arrays carve(BlockCarver& c, bool single) const;
+
   int r_ = 0;
   size_t pairs_ = 0;             // P = r(r+1)/2, for (a <= b) and for the products z_kl = q_k q_l
   const double* k2_ = nullptr;   // [pair]
