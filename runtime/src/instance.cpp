@@ -51,6 +51,7 @@ struct qv_instance {
   int* slotActive;
   // scratch
   double *force, *stiffness, *system, *rhs, *trialQ, *trialV, *next, *polyScratch;
+  double* rhsBackup;       // solve(): the right-hand side kept for the LU retry
   double* restStiffness;   // K(0), for linear modal dynamics
   int* pivot;
 
@@ -71,6 +72,7 @@ struct qv_instance {
     stiffness = c.template take<double>(rr);
     system = c.template take<double>(rr);
     rhs = c.template take<double>(r);
+    rhsBackup = c.template take<double>(r);
     trialQ = c.template take<double>(r);
     trialV = c.template take<double>(r);
     next = c.template take<double>(r);
@@ -113,9 +115,9 @@ struct qv_instance {
   qv_step_status solve(double c1, double c2) {
     fillSystem(c1, c2);
     // The Cholesky attempt spoils `system` and `rhs`, so keep the right-hand side for a second try.
-    std::memcpy(next, rhs, sizeof(double) * r);
+    std::memcpy(rhsBackup, rhs, sizeof(double) * r);
     if (quiver::rt::choleskySolve(system, rhs, r)) return QV_STEP_OK;
-    std::memcpy(rhs, next, sizeof(double) * r);
+    std::memcpy(rhs, rhsBackup, sizeof(double) * r);
     fillSystem(c1, c2);
     return quiver::rt::luSolve(system, rhs, pivot, r) ? QV_STEP_INDEFINITE : QV_STEP_RESET;
   }
@@ -139,12 +141,10 @@ struct qv_instance {
       }
       evaluate(trialQ, nullptr);
       for (int i = 0; i < r; ++i) rhs[i] = -(next[i] + damping(i, trialV) + force[i] - external(i));
-      // Save the acceleration guess: solve() uses `next` as scratch.
-      std::memcpy(trialV, next, sizeof(double) * r);
       const qv_step_status s = solve(gamma * h, beta * h * h);
       if (s == QV_STEP_RESET) return s;
       if (s == QV_STEP_INDEFINITE) status = s;
-      for (int i = 0; i < r; ++i) next[i] = trialV[i] + rhs[i];
+      for (int i = 0; i < r; ++i) next[i] += rhs[i];
     }
     for (int i = 0; i < r; ++i) {
       q[i] += h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * next[i]);
