@@ -5,7 +5,7 @@
 // (1/60 s per frame) for tests and recordings.
 #include <algorithm>
 #include <cstdio>
-#include <deque>
+#include <array>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -173,8 +173,8 @@ public:
         rateStart = now;
         rateSteps = 0;
       }
-      energy_.push_back(static_cast<float>(session_.kineticEnergy() + session_.elasticEnergy()));
-      if (energy_.size() > 300) energy_.pop_front();
+      energies_ = session_.energies();
+      totalEnergy_[energyFrames_++ % totalEnergy_.size()] = static_cast<float>(energies_.kinetic + energies_.elastic);
       if (!o_.noPanel) panel();
       ImGui::Render();
 
@@ -254,9 +254,10 @@ private:
                 session_.stepMicros() > 0 ? 1e6 / session_.stepMicros() : 0.0);
     if (session_.behindRealTime()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "slower than real time");
     if (session_.resets()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%d resets (diverged, back to rest)", session_.resets());
-    ImGui::Text("energy: kinetic %.3g J, elastic %.3g J", session_.kineticEnergy(), session_.elasticEnergy());
-    std::vector<float> energy(energy_.begin(), energy_.end());
-    ImGui::PlotLines("total", energy.data(), static_cast<int>(energy.size()), 0, nullptr, 0, FLT_MAX, ImVec2(0, 50));
+    ImGui::Text("energy: kinetic %.3g J, elastic %.3g J", energies_.kinetic, energies_.elastic);
+    const int shown = static_cast<int>(std::min<size_t>(energyFrames_, totalEnergy_.size()));  // a ring, oldest first
+    ImGui::PlotLines("kinetic + elastic", totalEnergy_.data(), shown, static_cast<int>(energyFrames_ % totalEnergy_.size()), nullptr, 0,
+                     FLT_MAX, ImVec2(0, 50));
 
     if (ImGui::CollapsingHeader("Simulation", ImGuiTreeNodeFlags_DefaultOpen)) {
       static const char* integrators[] = {"implicit Newmark", "backward Euler", "central differences"};
@@ -335,7 +336,9 @@ private:
   double lastX_ = 0, lastY_ = 0;
   int grabs_ = 0;
   double stepsPerSecond_ = 0;
-  std::deque<float> energy_;
+  ViewSession::Energies energies_{};
+  std::array<float, 300> totalEnergy_{};  // the last 300 frames' total energy
+  size_t energyFrames_ = 0;
   int modeKind_ = 0, modeIndex_ = 0;
   float modeAmplitude_ = 0.1f;
   bool smoothNormals_ = false;

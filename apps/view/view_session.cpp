@@ -154,16 +154,10 @@ void ViewSession::positions(std::vector<float>& out) const {
   for (size_t i = 0; i < out.size(); ++i) out[i] += static_cast<float>(rest[i]);
 }
 
-double ViewSession::kineticEnergy() const {
-  double kinetic = 0, elastic = 0;
-  qv_instance_energies(instance_->get(), &kinetic, &elastic);
-  return kinetic;
-}
-
-double ViewSession::elasticEnergy() const {
-  double kinetic = 0, elastic = 0;
-  qv_instance_energies(instance_->get(), &kinetic, &elastic);
-  return elastic;
+ViewSession::Energies ViewSession::energies() const {
+  Energies e{};
+  qv_instance_energies(instance_->get(), &e.kinetic, &e.elastic);
+  return e;
 }
 
 } // namespace quiver::app

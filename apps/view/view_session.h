@@ -70,8 +70,10 @@ public:
 
   // Deformed positions (3 floats per vertex): the simulation, or the shown mode.
   void positions(std::vector<float>& out) const;
-  double kineticEnergy() const;
-  double elasticEnergy() const;
+  struct Energies {
+    double kinetic, elastic;  // J
+  };
+  Energies energies() const;
   long stepsTaken() const { return steps_; }
   int resets() const { return resets_; }
   double stepMicros() const { return stepMicros_; }  // moving average of the step's cost

@@ -68,7 +68,7 @@ TEST_F(ViewSessionTest, APressHeldStillPullsNothingAndADragPullsAlongTheRay) {
     session.drag(down);
     session.advance(1.0 / 60);
   }
-  EXPECT_LT(session.kineticEnergy() + session.elasticEnergy(), 1e-12) << "the spring starts at the grabbed vertex";
+  EXPECT_LT(session.energies().kinetic + session.energies().elastic, 1e-12) << "the spring starts at the grabbed vertex";
   // The cursor 2 cm toward -y: the target moves 2 cm in the plane z = top, and the vertex follows.
   std::vector<float> before, after;
   session.positions(before);
