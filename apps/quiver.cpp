@@ -48,14 +48,8 @@ std::vector<double> parseQ(const std::string& text, int r) {
     std::stringstream in(text);
     std::string item;
     while (std::getline(in, item, ',')) {
-      size_t used = 0;
       double v = 0;
-      try {
-        v = std::stod(item, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != item.size() || item.empty()) throw std::runtime_error("--q: '" + item + "' is not a number");
+      if (!quiver::app::parseNumber(item, v)) throw std::runtime_error("--q: '" + item + "' is not a number");
       q.push_back(v);
     }
   }

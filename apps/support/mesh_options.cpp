@@ -39,16 +39,20 @@ FixedVertexRequest FixedVertexOptions::resolved() const {
 
 std::vector<int> FixedVertexOptions::select(const CheckedMesh& mesh) const { return selectFixedVertices(mesh, resolved()); }
 
+bool parseNumber(const std::string& text, double& value) {
+  size_t used = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    return false;
+  }
+  return used == text.size();
+}
+
 const CLI::Validator Positive(
     [](std::string& text) -> std::string {
-      size_t used = 0;
       double value = 0;
-      try {
-        value = std::stod(text, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      return used == text.size() && value > 0 ? "" : "expected a positive number, not '" + text + "'";
+      return parseNumber(text, value) && value > 0 ? "" : "expected a positive number, not '" + text + "'";
     },
     "POSITIVE");
 

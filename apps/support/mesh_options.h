@@ -32,6 +32,9 @@ struct FixedVertexOptions {
   std::vector<int> select(const CheckedMesh& mesh) const;
 };
 
+// All of `text` as a number (std::stod's syntax); false when it is not one or something follows it.
+bool parseNumber(const std::string& text, double& value);
+
 // A number above zero. CLI::PositiveNumber says "Value abc not in range 0 to 1.79e308" of a word;
 // this says what is expected.
 extern const CLI::Validator Positive;
