@@ -7,23 +7,20 @@
 #include <random>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include <gtest/gtest.h>
 
 #include "common/box_mesh.h"
 #include "formats/mesh/mesh_error.h"
+#include "tests/support/test_support.h"
 
 namespace quiver::test {
 
 // The message of the MeshError `parse()` throws, or "" when it returns (other exceptions propagate).
 template <class Parse>
 std::string meshErrorOf(Parse&& parse) {
-  try {
-    parse();
-  } catch (const MeshError& e) {
-    return e.what();
-  }
-  return "";
+  return errorOf<MeshError>(std::forward<Parse>(parse));
 }
 
 // `message` is "FILE:LINE: ..." and contains `what`.

@@ -1,5 +1,5 @@
 #pragma once
-// Small helpers shared by the tests: locating data and making scratch folders.
+// Small helpers shared by the tests: locating data, making scratch folders, catching errors.
 #include <string>
 
 namespace quiver::test {
@@ -12,6 +12,17 @@ std::string asset(const std::string& name);
 
 // A fresh, empty folder for one test's files.
 std::string tempDir(const std::string& testName);
+
+// The message of the `Error` that `call()` throws, or "" when it returns (other exceptions propagate).
+template <class Error, class Call>
+std::string errorOf(Call&& call) {
+  try {
+    call();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
 
 } // namespace quiver::test
 

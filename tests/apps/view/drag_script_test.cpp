@@ -4,6 +4,8 @@
 
 #include <stdexcept>
 
+#include "tests/support/test_support.h"
+
 namespace quiver::app {
 namespace {
 
@@ -39,13 +41,9 @@ TEST(DragScript, MistakesNameTheFileAndLine) {
       {"-1 press 0 0", "s.txt:1: '-1' is not a frame number"},
   };
   for (const auto& [text, message] : cases) {
-    try {
-      DragScript::parse(text, "s.txt");
-      ADD_FAILURE() << "accepted: " << text;
-    } catch (const std::runtime_error& e) {
-      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
-    }
-  }
+    const std::string error = test::errorOf<std::runtime_error>([t = text] { DragScript::parse(t, "s.txt"); });
+    EXPECT_NE(error.find(message), std::string::npos) << "'" << text << "' gave '" << error << "'";
+  };
 }
 
 TEST(DragScript, AMissingFileIsNamed) {
