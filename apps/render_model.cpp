@@ -39,13 +39,14 @@ Image picture(const Camera& cam, int width, int height, const std::vector<float>
 // displacement is `amplitude` of the model's diagonal, then by `phase` in [-1, 1].
 class ModeGrid {
 public:
-  ModeGrid(const RuntimeModel& model, const RenderOptions& o) : model_(model), o_(o) {
+  ModeGrid(const RuntimeModel& model, const RenderOptions& o) : model_(model), o_(o), triangles_(model.triangles()) {
     const qv_model_info& info = model.info();
     count_ = std::min(o.modes, info.r);
     columns_ = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(count_))));
     const int rows = (count_ + columns_ - 1) / columns_;
     tileW_ = o.size[0] / columns_;
     tileH_ = o.size[1] / rows;
+    camera_ = camera(info, tileW_, tileH_, o.amplitude);
     const Eigen::MatrixXd directions =
         o.basis ? Eigen::MatrixXd::Identity(info.r, info.r) : reducedModes(model.get()).vectors;
     const double size = (Eigen::Vector3d(info.bbox_max) - Eigen::Vector3d(info.bbox_min)).norm();
@@ -54,18 +55,13 @@ public:
   }
 
   Image draw(double phase) const {
-    const qv_model_info& info = model_.info();
-    const Camera cam = camera(info, tileW_, tileH_, o_.amplitude);
-    const double* rest = qv_model_rest_positions(model_.get());
-    const std::vector<unsigned> triangles = model_.triangles();
-    std::vector<float> u(3 * static_cast<size_t>(info.vertex_count));
+    std::vector<float> x;
     Image image(o_.size[0], o_.size[1]);
     image.clear(kWhite);
     for (int j = 0; j < count_; ++j) {
       const Eigen::VectorXd q = phase * shapes_[j];
-      qv_model_displacements(model_.get(), q.data(), u.data());
-      for (size_t i = 0; i < u.size(); ++i) u[i] += static_cast<float>(rest[i]);
-      image.paste(picture(cam, tileW_, tileH_, u, triangles), (j % columns_) * tileW_, (j / columns_) * tileH_);
+      model_.positionsAt(q.data(), x);
+      image.paste(picture(camera_, tileW_, tileH_, x, triangles_), (j % columns_) * tileW_, (j / columns_) * tileH_);
     }
     return image;
   }
@@ -73,7 +69,9 @@ public:
 private:
   const RuntimeModel& model_;
   const RenderOptions& o_;
+  std::vector<unsigned> triangles_;
   int count_, columns_, tileW_, tileH_;
+  Camera camera_;
   std::vector<Eigen::VectorXd> shapes_;
 };
 

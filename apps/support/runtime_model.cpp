@@ -21,6 +21,13 @@ std::vector<unsigned> RuntimeModel::triangles() const {
   return std::vector<unsigned>(t, t + 3 * static_cast<size_t>(info_.triangle_count));
 }
 
+void RuntimeModel::positionsAt(const double* q, std::vector<float>& out) const {
+  out.resize(3 * static_cast<size_t>(info_.vertex_count));
+  qv_model_displacements(model_, q, out.data());
+  const double* rest = qv_model_rest_positions(model_);
+  for (size_t i = 0; i < out.size(); ++i) out[i] += static_cast<float>(rest[i]);
+}
+
 TetMesh RuntimeModel::mesh() const {
   // The runtime keeps no tets (it does not need them); the file has them.
   const std::string bytes = readFileBytes(path_);

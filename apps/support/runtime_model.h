@@ -20,6 +20,8 @@ public:
   const qv_model_info& info() const { return info_; }
   const std::string& path() const { return path_; }
   std::vector<unsigned> triangles() const;
+  // Positions X + U q (3 floats per vertex) of reduced coordinates `q` (r values), without an instance.
+  void positionsAt(const double* q, std::vector<float>& out) const;
   // Rest shape and tets, for vertex selection and .vtu frames.
   TetMesh mesh() const;
 

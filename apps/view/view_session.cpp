@@ -143,15 +143,13 @@ void ViewSession::showMode(ModeKind kind, int index, double amplitude) {
 }
 
 void ViewSession::positions(std::vector<float>& out) const {
-  out.resize(3 * static_cast<size_t>(model_.info().vertex_count));
   if (modeKind_ == ModeKind::None) {
+    out.resize(3 * static_cast<size_t>(model_.info().vertex_count));
     qv_instance_positions(instance_->get(), out.data());
     return;
   }
   const Eigen::VectorXd q = std::sin(2 * M_PI * modeTime_ / kModePeriod) * modeShape_;
-  qv_model_displacements(model_.get(), q.data(), out.data());
-  const double* rest = qv_model_rest_positions(model_.get());
-  for (size_t i = 0; i < out.size(); ++i) out[i] += static_cast<float>(rest[i]);
+  model_.positionsAt(q.data(), out);
 }
 
 ViewSession::Energies ViewSession::energies() const {
