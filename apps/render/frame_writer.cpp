@@ -154,19 +154,18 @@ void FrameWriter::add(const Image& frame) {
     }
     {
       // Whole hundredths per frame, with the rounding carried over, so the animation keeps time.
-      const long end = std::lround(100 * frameSeconds_ * (frames_ + 1));
-      gif_->add(path_, frame, std::max(2L, end - shownCentiseconds_));
-      shownCentiseconds_ += std::max(2L, end - shownCentiseconds_);
+      const long delay = std::max(2L, std::lround(100 * frameSeconds_ * (frames_ + 1)) - shownCentiseconds_);
+      gif_->add(path_, frame, delay);
+      shownCentiseconds_ += delay;
     }
     break;
   }
   ++frames_;
 }
 
-int FrameWriter::finish() {
+void FrameWriter::finish() {
   if (kind_ == Kind::Picture && last_) writePng(path_, *last_);
   if (kind_ == Kind::Gif && gif_) gif_->close(path_);
-  return kind_ == Kind::Picture ? (last_ ? 1 : 0) : frames_;
 }
 
 } // namespace quiver::app

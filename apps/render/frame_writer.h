@@ -24,8 +24,8 @@ public:
   // True when every frame is kept (sequence or GIF); a single picture only needs the last one.
   bool animated() const;
   void add(const Image& frame);
-  // Writes what is pending (the picture or the GIF); returns the number of frames written.
-  int finish();
+  // Writes what is pending (the picture or the GIF).
+  void finish();
 
 private:
   struct Gif;
