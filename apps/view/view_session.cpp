@@ -50,19 +50,17 @@ void ViewSession::configure(const ViewSettings& wanted) {
   const bool same = next.integrator == now.integrator && next.time_step == now.time_step &&
                     next.newton_iterations == now.newton_iterations && next.rayleigh_alpha == now.rayleigh_alpha &&
                     next.rayleigh_beta == now.rayleigh_beta && next.linear == now.linear && next.warping == now.warping;
+  std::vector<double> q, v;  // the state a new instance continues from
   if (!same) {
     auto replacement = std::make_unique<RuntimeInstance>(model_, next);  // throws before anything changes
-    const int r = model_.info().r;
-    std::vector<double> q(r), v(r);
+    q.resize(model_.info().r);
+    v.resize(q.size());
     qv_instance_get_state(instance_->get(), q.data(), v.data(), nullptr);
     instance_ = std::move(replacement);
-    settings_ = s;
-    applyLoads();
-    qv_instance_set_state(instance_->get(), q.data(), v.data(), nullptr);
-  } else {
-    settings_ = s;
-    applyLoads();
   }
+  settings_ = s;
+  applyLoads();  // before the state, so that its acceleration sees the loads
+  if (!same) qv_instance_set_state(instance_->get(), q.data(), v.data(), nullptr);
 }
 
 void ViewSession::applyLoads() {
