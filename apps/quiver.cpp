@@ -26,14 +26,12 @@ ordered_json sectionSizes(const std::string& path) {
   const std::string bytes = quiver::readFileBytes(path);
   auto u32 = [&](size_t at) { uint32_t v; std::memcpy(&v, &bytes[at], 4); return v; };
   auto u64 = [&](size_t at) { uint64_t v; std::memcpy(&v, &bytes[at], 8); return v; };
-  static const char* names[] = {"", "MODEL_INFO", "ENERGY_COEFFICIENTS", "BASIS", "REST_POSITIONS",
-                                "SURFACE_TRIANGLES", "VERTEX_MAP", "GRAVITY_PROJECTION", "EIGENVALUES", "TETS"};
   ordered_json out = ordered_json::object();
   const uint64_t table = u64(quiver::qvr::kTableOffsetAt);
   for (uint32_t s = 0; s < u32(quiver::qvr::kSectionCountAt); ++s) {
     const size_t entry = table + s * quiver::qvr::kSectionEntrySize;
     const uint32_t type = u32(entry + quiver::qvr::kTypeAt);
-    out[type < std::size(names) ? names[type] : "type " + std::to_string(type)] = u64(entry + quiver::qvr::kSizeAt);
+    out[quiver::qvr::sectionName(type)] = u64(entry + quiver::qvr::kSizeAt);
   }
   out["file"] = bytes.size();
   return out;
@@ -71,17 +69,10 @@ int main(int argc, char** argv) {
   eval->add_option("--q", qText, "Reduced coordinates: r comma-separated numbers, or FILE.npy")->required();
   CLI::App* sim = app.add_subcommand("sim", "Run a scripted scenario; write a .vtu series (.pvd), a CSV and timings");
   quiver::app::SimOptions simOptions;
-  std::string integrator = "newmark";
-  std::string elasticity = "stvk";
   sim->add_option("model", path, "Model file (.qvr)")->required();
   simOptions.addTo(*sim);
-  sim->add_option("--integrator", integrator, "newmark, euler or central")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"newmark", "euler", "central"}));
-  sim->add_option("--elasticity", elasticity,
-                  "stvk (the reduced model), linear (R = K(0) q in the same subspace) or warping (linear + modal warping)")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"stvk", "linear", "warping"}));
+  quiver::app::addIntegratorOption(*sim, simOptions.step.integrator);
+  quiver::app::addElasticityOption(*sim, simOptions.step.elasticity);
   CLI::App* render = app.add_subcommand("render", "Draw MODEL.qvr without a display: rest, after (or during) a scenario, or its modes; PNG, GIF or image sequence");
   quiver::app::RenderOptions renderOptions;
   render->add_option("model", path, "Model file (.qvr)")->required();
@@ -98,10 +89,7 @@ int main(int argc, char** argv) {
                         "Sparse solver: llt, ldlt (Eigen Simplicial), cg (incomplete Cholesky), lu (SparseLU)")
       ->capture_default_str()
       ->check(CLI::IsMember({"llt", "ldlt", "cg", "lu"}));
-  fullSpace->add_option("--elasticity", fullOptions.elasticity,
-                        "stvk, linear (K(0), the full linear system) or warping (linear + per-vertex modal warping)")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"stvk", "linear", "warping"}));
+  quiver::app::addElasticityOption(*fullSpace, fullSim.step.elasticity);
   fullSpace->add_option("--E", fullOptions.material.youngsModulus, "Young's modulus in Pa; overrides the mesh file's");
   fullSpace->add_option("--nu", fullOptions.material.poissonRatio, "Poisson ratio; overrides the mesh file's");
   fullSpace->add_option("--density", fullOptions.material.density, "Density in kg/m^3; overrides the mesh file's");
@@ -117,7 +105,7 @@ int main(int argc, char** argv) {
                                             fullSim);
     }
     if (*render) return quiver::app::renderModel(path, renderOptions);
-    if (*sim) return quiver::app::simulateModel(path, integrator, elasticity, simOptions);
+    if (*sim) return quiver::app::simulateModel(path, simOptions);
     const quiver::app::RuntimeModel model(path);
     const qv_model_info& mi = model.info();
     ordered_json out;

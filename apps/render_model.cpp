@@ -90,7 +90,7 @@ void RenderOptions::addTo(CLI::App& app) {
       ->capture_default_str()
       ->check(Positive);
   // Pictures are for looking at, not timing: enough Newton iterations that a strong pull is drawn converged.
-  scenario.newton = 3;
+  scenario.step.newton = 3;
   scenario.addScenarioTo(app);
 }
 
@@ -110,7 +110,7 @@ int renderModel(const std::string& path, const RenderOptions& o) {
     frames.finish();
     return 0;
   }
-  RuntimeTarget target(model, "newmark", "stvk", o.scenario);
+  RuntimeTarget target(model, o.scenario.step);
   FrameWriter frames(o.output, o.every * target.timeStep());
   const Camera cam = camera(model.info(), width, height, 0.15);
   const std::vector<unsigned> triangles = model.triangles();

@@ -4,29 +4,8 @@
 
 namespace quiver::app {
 
-namespace {
-
-qv_instance_config simulationConfig(const RuntimeModel& model, const std::string& integrator,
-                                    const std::string& elasticity, const SimOptions& o) {
-  qv_instance_config config;
-  qv_instance_config_init(&config, model.get());
-  config.integrator = integrator == "euler"     ? QV_INTEGRATOR_BACKWARD_EULER
-                      : integrator == "central" ? QV_INTEGRATOR_CENTRAL_DIFFERENCES
-                                                : QV_INTEGRATOR_IMPLICIT_NEWMARK;
-  if (o.timeStep > 0) config.time_step = o.timeStep;
-  config.newton_iterations = o.newton;
-  config.linear = elasticity == "linear";
-  config.warping = elasticity == "warping";
-  if (o.alpha >= 0) config.rayleigh_alpha = o.alpha;
-  if (o.beta >= 0) config.rayleigh_beta = o.beta;
-  return config;
-}
-
-} // namespace
-
-RuntimeTarget::RuntimeTarget(const RuntimeModel& model, const std::string& integrator, const std::string& elasticity,
-                             const SimOptions& o)
-    : model_(model), instance_(model, simulationConfig(model, integrator, elasticity, o)) {
+RuntimeTarget::RuntimeTarget(const RuntimeModel& model, const StepSettings& settings)
+    : model_(model), instance_(model, instanceConfig(model.get(), settings)) {
   const double stable = qv_instance_stable_time_step(instance_.get());
   if (instance_.config().integrator == QV_INTEGRATOR_CENTRAL_DIFFERENCES && instance_.config().time_step > stable)
     std::cerr << "quiver: warning: --dt " << instance_.config().time_step << " s is above central differences' stable step "

@@ -9,10 +9,8 @@ namespace quiver::app {
 
 class RuntimeTarget : public ScenarioTarget {
 public:
-  // `integrator`: newmark | euler | central; `elasticity`: stvk | linear | warping.
-  RuntimeTarget(const RuntimeModel& model, const std::string& integrator, const std::string& elasticity,
-                const SimOptions& options);
-  RuntimeTarget(RuntimeModel&&, const std::string&, const std::string&, const SimOptions&) = delete;  // kept by reference
+  RuntimeTarget(const RuntimeModel& model, const StepSettings& settings);
+  RuntimeTarget(RuntimeModel&&, const StepSettings&) = delete;  // kept by reference
   void addVertexForce(int vertex, const double force[3]) override;
   void setGravity(const double acceleration[3]) override;
   void setSprings(const std::vector<int>& vertices, const std::vector<double>& targets, double stiffness) override;

@@ -50,13 +50,11 @@ int simulateFullSpace(const TetMesh& mesh, const std::vector<int>& fileVertex, s
                       const std::vector<int>& fixed, const FullSpaceOptions& full, const SimOptions& o) {
   FullSpaceSettings settings;
   settings.solver = parseSparseSolver(full.solver);
-  settings.elasticity = full.elasticity == "linear"    ? Elasticity::Linear
-                        : full.elasticity == "warping" ? Elasticity::Warping
-                                                       : Elasticity::StVK;
-  if (o.timeStep > 0) settings.timeStep = o.timeStep;
-  if (o.alpha >= 0) settings.rayleighAlpha = o.alpha;
-  if (o.beta >= 0) settings.rayleighBeta = o.beta;
-  settings.maxNewtonIterations = std::max(o.newton, 20);
+  settings.elasticity = o.step.elasticity;
+  if (o.step.timeStep > 0) settings.timeStep = o.step.timeStep;
+  if (o.step.alpha >= 0) settings.rayleighAlpha = o.step.alpha;
+  if (o.step.beta >= 0) settings.rayleighBeta = o.step.beta;
+  settings.maxNewtonIterations = std::max(o.step.newton, 20);
   std::vector<Material> perTet = resolveTetMaterials(mesh, Material{}, full.material);
   for (const Material& m : perTet)
     if (std::string bad = checkMaterial(m); !bad.empty()) throw std::runtime_error(bad);
@@ -75,7 +73,7 @@ int simulateFullSpace(const TetMesh& mesh, const std::vector<int>& fileVertex, s
     nlohmann::ordered_json j;
     j["dofs"] = target.simulator().dofCount();
     j["solver"] = full.solver;
-    j["elasticity"] = full.elasticity;
+    j["elasticity"] = qv_elasticity_name(o.step.elasticity);
     j["steps"] = o.steps;
     j["time_step_s"] = settings.timeStep;
     j["step_ms_mean"] = 1e-3 * total / o.steps;

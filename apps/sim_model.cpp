@@ -7,10 +7,9 @@
 
 namespace quiver::app {
 
-int simulateModel(const std::string& path, const std::string& integrator, const std::string& elasticity,
-                  const SimOptions& o) {
+int simulateModel(const std::string& path, const SimOptions& o) {
   const RuntimeModel model(path);
-  RuntimeTarget target(model, integrator, elasticity, o);
+  RuntimeTarget target(model, o.step);
   const ScenarioResult result = runScenario(target, model.mesh(), o);
   double total = 0;
   for (double us : result.stepMicros) total += us;
@@ -20,8 +19,8 @@ int simulateModel(const std::string& path, const std::string& integrator, const 
     j["r"] = model.info().r;
     j["steps"] = o.steps;
     j["time_step_s"] = target.timeStep();
-    j["integrator"] = integrator;
-    j["elasticity"] = elasticity;
+    j["integrator"] = qv_integrator_name(o.step.integrator);
+    j["elasticity"] = qv_elasticity_name(o.step.elasticity);
     j["step_us_median"] = median;
     j["step_us_p99"] = p99;
     j["steps_per_second"] = 1e6 * o.steps / total;

@@ -28,10 +28,10 @@ void SimOptions::addScenarioTo(CLI::App& app) {
       ->check(CLI::IsMember({"x", "y", "z"}));
   app.add_option("--stiffness", stiffness, "Drag: penalty spring per vertex, N/m")->capture_default_str();
   app.add_flag("--gravity", gravity, "Gravity, 9.81 m/s^2 along -z");
-  app.add_option("--dt", timeStep, "Time step, s")->check(Positive);
-  app.add_option("--newton", newton, "Newton iterations per implicit step (full space: the most)")->capture_default_str();
-  app.add_option("--alpha", alpha, "Mass-proportional damping, 1/s");
-  app.add_option("--beta", beta, "Stiffness-proportional damping, s");
+  app.add_option("--dt", step.timeStep, "Time step, s")->check(Positive);
+  app.add_option("--newton", step.newton, "Newton iterations per implicit step (full space: the most)")->capture_default_str();
+  app.add_option("--alpha", step.alpha, "Mass-proportional damping, 1/s");
+  app.add_option("--beta", step.beta, "Stiffness-proportional damping, s");
   app.add_option("--scenario", scenarioFile,
                  "Read scenario options from FILE, one 'name = value' per line (apps/support/scenario_file.h)");
 }
@@ -88,7 +88,7 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
   const std::vector<int> group = selectGroup(mesh, o.group);
   const bool dragMode = o.twist != 0 || o.drag != std::vector<double>{0, 0, 0};
   if (o.gravity) {
-    const double g[3] = {0, 0, -9.81};
+    const double g[3] = {0, 0, -kGravity};
     target.setGravity(g);
   }
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();

@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "apps/support/step_settings.h"
 #include "common/tet_mesh.h"
 
 namespace quiver::app {
@@ -23,9 +24,8 @@ struct SimOptions {
   std::string axis = "x";               // x | y | z: the twist axis
   double stiffness = 1e4;               // N/m per vertex, drag mode's penalty springs
   bool gravity = false;                 // add g = 9.81 m/s^2 along -z
-  double timeStep = 0;                  // s; 0: the simulator's default
-  int newton = 1;                       // Newton iterations per step (runtime), or the most (full space)
-  double alpha = -1, beta = -1;         // Rayleigh damping; negative: the default
+  StepSettings step;                    // integrator, elasticity, time step, Newton iterations per step
+                                        // (runtime; full space: at most), Rayleigh damping
   std::string output;                   // NAME: NAME.pvd, NAME_NNNNN.vtu, NAME.csv; "" for none
   int every = 1;                        // write every k-th step
   bool json = false;                    // print one JSON summary instead of text
@@ -74,14 +74,10 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
 double percentile(std::vector<double> values, double p);
 
 // `quiver sim MODEL.qvr`: returns the exit code.
-// `elasticity`: "stvk" (the model's), "linear" (R = K(0) q in the same subspace) or "warping"
-// (linear, with modal warping).
-int simulateModel(const std::string& modelPath, const std::string& integrator, const std::string& elasticity,
-                  const SimOptions& options);
+int simulateModel(const std::string& modelPath, const SimOptions& options);
 
 struct FullSpaceOptions {
   std::string solver = "ldlt";          // llt | ldlt | cg | lu
-  std::string elasticity = "stvk";      // stvk | linear | warping (linear + per-vertex modal warping)
   MaterialOverride material;            // over the mesh file's materials
   std::string finalNpy;                 // save the final displacement (3N, the file's vertex order)
 };

@@ -8,7 +8,7 @@
 
 #include "common/mass_matrix.h"
 #include "common/modal_rotation.h"
-#include "formats/model/modal_warping.h"
+#include "quiver/modal_warping.h"
 
 namespace quiver {
 
@@ -63,7 +63,7 @@ FullSpaceSimulator::~FullSpaceSimulator() = default;
 void FullSpaceSimulator::addVertexForce(int vertex, const Eigen::Vector3d& force) {
   if (vertex < 0 || 3 * vertex >= dofCount()) throw std::invalid_argument("addVertexForce: no such vertex");
   Eigen::Vector3d local = force;
-  if (settings_.elasticity == Elasticity::Warping) {  // into the vertex's rotated frame
+  if (settings_.elasticity == QV_ELASTICITY_MODAL_WARPING) {  // into the vertex's rotated frame
     const Eigen::Vector3d back = -vertexRotations(mesh_, u_).middleRows(3 * vertex, 3);
     warping::rotate(back.data(), force.data(), local.data());
   }
@@ -71,7 +71,7 @@ void FullSpaceSimulator::addVertexForce(int vertex, const Eigen::Vector3d& force
 }
 
 Eigen::VectorXd FullSpaceSimulator::displacement() const {
-  if (settings_.elasticity != Elasticity::Warping) return u_;
+  if (settings_.elasticity != QV_ELASTICITY_MODAL_WARPING) return u_;
   const Eigen::MatrixXd w = vertexRotations(mesh_, u_);
   Eigen::VectorXd out(u_.size());
   for (int v = 0; 3 * v < dofCount(); ++v)
@@ -80,7 +80,7 @@ Eigen::VectorXd FullSpaceSimulator::displacement() const {
 }
 
 double FullSpaceSimulator::elasticEnergy() const {
-  return settings_.elasticity == Elasticity::StVK ? model_.energy(u_) : 0.5 * u_.dot(restStiffness_ * u_);
+  return settings_.elasticity == QV_ELASTICITY_STVK ? model_.energy(u_) : 0.5 * u_.dot(restStiffness_ * u_);
 }
 
 void FullSpaceSimulator::setGravity(const Eigen::Vector3d& g) {
@@ -180,7 +180,7 @@ int FullSpaceSimulator::newmarkStep(double h) {
   auto residualAt = [&](const Eigen::VectorXd& acc, Eigen::VectorXd& out, bool withTangent) {
     q = u_ + h * v_ + h * h * ((0.5 - beta) * a_ + beta * acc);
     vel = v_ + h * ((1 - gamma) * a_ + gamma * acc);
-    if (settings_.elasticity == Elasticity::StVK) {
+    if (settings_.elasticity == QV_ELASTICITY_STVK) {
       model_.internalForce(q, force_);
       if (withTangent) model_.tangentStiffness(q, tangent_);
     } else {

@@ -16,14 +16,12 @@
 #include <Eigen/SparseCore>
 
 #include "common/stvk_force_model.h"
+#include "quiver/quiver.h"
 
 namespace quiver {
 
 enum class SparseSolver { LLT, LDLT, CG, LU };
 
-// St.Venant-Kirchhoff; linear elasticity (R = K(0) u); or linear elasticity with per-vertex modal
-// warping of the output (Choi & Ko 2005, every free DOF a mode: the full linear system).
-enum class Elasticity { StVK, Linear, Warping };
 
 // "llt", "ldlt", "cg", "lu"; throws std::invalid_argument for anything else.
 SparseSolver parseSparseSolver(const std::string& name);
@@ -35,7 +33,10 @@ struct FullSpaceSettings {
   int maxNewtonIterations = 20;    // per step
   double newtonTolerance = 1e-8;   // stop when ||residual|| <= tolerance * (||M a|| + ||f|| + tiny)
   SparseSolver solver = SparseSolver::LDLT;
-  Elasticity elasticity = Elasticity::StVK;
+  // The runtime's choices, in full space: St.Venant-Kirchhoff; linear elasticity (R = K(0) u); or
+  // linear elasticity with per-vertex modal warping of the output (Choi & Ko 2005, every free DOF a
+  // mode: the full linear system).
+  qv_elasticity elasticity = QV_ELASTICITY_STVK;
   double cgTolerance = 1e-12;      // relative residual of each CG solve
 };
 

@@ -2,7 +2,7 @@
 // Small rotations of displacement fields, for modal warping (Choi & Ko 2005): the rotation of a
 // field u is w = (1/2) curl u, constant on a linear tet; each vertex gets the volume-weighted mean
 // of its tets' rotations. For a basis U, the vertex rotations are linear in q: w_v = Psi_v q. The
-// bake stores Psi in the .qvr; the runtime warps with it (formats/model/modal_warping.h).
+// bake stores Psi in the .qvr; the runtime warps with it (quiver/modal_warping.h).
 #include <Eigen/Core>
 
 #include "common/tet_mesh.h"

@@ -47,7 +47,7 @@ TetMesh RuntimeModel::mesh() const {
 RuntimeInstance::RuntimeInstance(const RuntimeModel& model, const qv_instance_config& config)
     : config_(config), vertexCount_(static_cast<size_t>(model.info().vertex_count)) {
   if (qv_instance_create(model.get(), &config_, nullptr, &instance_) != QV_OK)
-    throw std::runtime_error(config_.warping && !model.info().has_modal_rotations
+    throw std::runtime_error(config_.elasticity == QV_ELASTICITY_MODAL_WARPING && !model.info().has_modal_rotations
                                  ? model.path() + " has no modal rotations (bake it again for modal warping)"
                                  : "invalid simulation settings (time step, Newton iterations, damping)");
 }

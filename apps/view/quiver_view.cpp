@@ -38,7 +38,6 @@ struct ViewOptions {
   std::string dragScript;
   bool noPanel = false;
   std::string showMode;  // "linear:N" or "basis:N": start in the mode browser
-  std::string integrator = "newmark", elasticity = "stvk";
   ViewSettings settings;
 };
 
@@ -113,6 +112,8 @@ public:
                                      double(o.size[0]) / o.size[1])),
         size_((Eigen::Vector3d(model.info().bbox_max) - Eigen::Vector3d(model.info().bbox_min)).norm()) {
     edited_ = session_.settings();
+    for (int i = 0; i < QV_INTEGRATOR_COUNT; ++i) integratorLabels_[i] = qv_integrator_description(qv_integrator(i));
+    for (int i = 0; i < QV_ELASTICITY_COUNT; ++i) elasticityLabels_[i] = qv_elasticity_description(qv_elasticity(i));
     if (!o.dragScript.empty()) script_ = DragScript::load(o.dragScript);
     if (!o.showMode.empty()) {
       const size_t colon = o.showMode.find(':');
@@ -260,25 +261,25 @@ private:
                      FLT_MAX, ImVec2(0, 50));
 
     if (ImGui::CollapsingHeader("Simulation", ImGuiTreeNodeFlags_DefaultOpen)) {
-      static const char* integrators[] = {"implicit Newmark", "backward Euler", "central differences"};
-      int integrator = edited_.integrator;
-      if (ImGui::Combo("integrator", &integrator, integrators, 3)) edited_.integrator = qv_integrator(integrator);
-      static const char* elasticities[] = {"St.Venant-Kirchhoff", "linear modal", "modal warping"};
-      int elasticity = static_cast<int>(edited_.elasticity);
-      if (ImGui::Combo("elasticity", &elasticity, elasticities, info.has_modal_rotations ? 3 : 2))
-        edited_.elasticity = Elasticity(elasticity);
+      int integrator = edited_.step.integrator;
+      if (ImGui::Combo("integrator", &integrator, integratorLabels_, QV_INTEGRATOR_COUNT))
+        edited_.step.integrator = qv_integrator(integrator);
+      int elasticity = edited_.step.elasticity;
+      if (ImGui::Combo("elasticity", &elasticity, elasticityLabels_,
+                       info.has_modal_rotations ? QV_ELASTICITY_COUNT : QV_ELASTICITY_MODAL_WARPING))
+        edited_.step.elasticity = qv_elasticity(elasticity);
       double stepMs = 1000 * session_.config().time_step;
       if (ImGui::InputDouble("time step, ms", &stepMs, 0.5, 5, "%.3f", ImGuiInputTextFlags_EnterReturnsTrue) && stepMs > 0)
-        edited_.timeStep = stepMs / 1000;
-      if (edited_.integrator == QV_INTEGRATOR_CENTRAL_DIFFERENCES)
+        edited_.step.timeStep = stepMs / 1000;
+      if (edited_.step.integrator == QV_INTEGRATOR_CENTRAL_DIFFERENCES)
         ImGui::Text("stable below %.3f ms", 1000 * session_.stableTimeStep());
       else
-        ImGui::SliderInt("Newton iterations", &edited_.newtonIterations, 1, 5);
+        ImGui::SliderInt("Newton iterations", &edited_.step.newton, 1, 5);
       double alpha = session_.config().rayleigh_alpha, beta = session_.config().rayleigh_beta;
       if (ImGui::InputDouble("damping alpha, 1/s", &alpha, 0, 0, "%.4g", ImGuiInputTextFlags_EnterReturnsTrue))
-        edited_.alpha = std::max(alpha, 0.0);
+        edited_.step.alpha = std::max(alpha, 0.0);
       if (ImGui::InputDouble("damping beta, s", &beta, 0, 0, "%.4g", ImGuiInputTextFlags_EnterReturnsTrue))
-        edited_.beta = std::max(beta, 0.0);
+        edited_.step.beta = std::max(beta, 0.0);
       ImGui::Checkbox("gravity", &edited_.gravity);
       float spring = static_cast<float>(edited_.springStiffness);
       if (ImGui::SliderFloat("mouse spring, N/m", &spring, 1e-3f * spring + 1e-9f, 1e3f * spring, "%.3g",
@@ -326,6 +327,8 @@ private:
   const RuntimeModel& model_;
   ViewSession session_;
   ViewSettings edited_;
+  const char* integratorLabels_[QV_INTEGRATOR_COUNT];  // the panel's menus, from the runtime's tables
+  const char* elasticityLabels_[QV_ELASTICITY_COUNT];
   std::string settingsError_;
   std::vector<unsigned> triangles_;
   std::vector<float> positions_, normals_;
@@ -354,14 +357,10 @@ int main(int argc, char** argv) {
   ViewOptions o;
   app.add_option("model", o.model, "Model file (.qvr)")->required();
   app.add_option("--size", o.size, "Window width,height in pixels")->delimiter(',')->expected(2)->capture_default_str();
-  app.add_option("--integrator", o.integrator, "newmark, euler or central")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"newmark", "euler", "central"}));
-  app.add_option("--elasticity", o.elasticity, "stvk, linear or warping")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"stvk", "linear", "warping"}));
-  app.add_option("--dt", o.settings.timeStep, "Time step, s (default: the model's)")->check(Positive);
-  app.add_option("--newton", o.settings.newtonIterations, "Newton iterations per implicit step")
+  addIntegratorOption(app, o.settings.step.integrator);
+  addElasticityOption(app, o.settings.step.elasticity);
+  app.add_option("--dt", o.settings.step.timeStep, "Time step, s (default: the model's)")->check(Positive);
+  app.add_option("--newton", o.settings.step.newton, "Newton iterations per implicit step")
       ->capture_default_str()
       ->check(CLI::Range(1, 20));
   app.add_flag("--gravity", o.settings.gravity, "Start with gravity, 9.81 m/s^2 along -z");
@@ -375,12 +374,6 @@ int main(int argc, char** argv) {
     if (o.size.size() != 2 || o.size[0] < 64 || o.size[1] < 64 || o.size[0] > 8192 || o.size[1] > 8192)
       throw std::runtime_error("--size must be two numbers between 64 and 8192");
     if (!o.screenshot.empty() && o.frames == 0) throw std::runtime_error("--screenshot needs --frames N");
-    o.settings.integrator = o.integrator == "euler"     ? QV_INTEGRATOR_BACKWARD_EULER
-                            : o.integrator == "central" ? QV_INTEGRATOR_CENTRAL_DIFFERENCES
-                                                        : QV_INTEGRATOR_IMPLICIT_NEWMARK;
-    o.settings.elasticity = o.elasticity == "linear"    ? Elasticity::Linear
-                            : o.elasticity == "warping" ? Elasticity::Warping
-                                                        : Elasticity::StVK;
     const RuntimeModel model(o.model);
     Viewer viewer(o, model);
     return viewer.run();

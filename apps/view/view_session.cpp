@@ -7,25 +7,10 @@
 namespace quiver::app {
 
 bool ViewSettings::operator==(const ViewSettings& o) const {
-  return integrator == o.integrator && elasticity == o.elasticity && timeStep == o.timeStep &&
-         newtonIterations == o.newtonIterations && alpha == o.alpha && beta == o.beta && gravity == o.gravity &&
-         springStiffness == o.springStiffness;
+  return step == o.step && gravity == o.gravity && springStiffness == o.springStiffness;
 }
 
 namespace {
-
-qv_instance_config instanceConfig(const RuntimeModel& model, const ViewSettings& s) {
-  qv_instance_config c;
-  qv_instance_config_init(&c, model.get());
-  c.integrator = s.integrator;
-  if (s.timeStep > 0) c.time_step = s.timeStep;
-  c.newton_iterations = s.newtonIterations;
-  if (s.alpha >= 0) c.rayleigh_alpha = s.alpha;
-  if (s.beta >= 0) c.rayleigh_beta = s.beta;
-  c.linear = s.elasticity == Elasticity::Linear;
-  c.warping = s.elasticity == Elasticity::Warping;
-  return c;
-}
 
 // A spring that moves the object visibly without fighting the solver: three times the stiffness
 // the whole mass has in the first mode (k = m omega_1^2).
@@ -39,17 +24,17 @@ double defaultSpringStiffness(const RuntimeModel& model, const ReducedModes& mod
 ViewSession::ViewSession(const RuntimeModel& model, const ViewSettings& settings)
     : model_(model), settings_(settings), modes_(reducedModes(model.get())) {
   if (settings_.springStiffness <= 0) settings_.springStiffness = defaultSpringStiffness(model, modes_);
-  instance_ = std::make_unique<RuntimeInstance>(model_, instanceConfig(model_, settings_));
+  instance_ = std::make_unique<RuntimeInstance>(model_, instanceConfig(model_.get(), settings_.step));
   applyLoads();
 }
 
 void ViewSession::configure(const ViewSettings& wanted) {
   ViewSettings s = wanted;
   if (s.springStiffness <= 0) s.springStiffness = defaultSpringStiffness(model_, modes_);
-  const qv_instance_config next = instanceConfig(model_, s), now = instance_->config();
+  const qv_instance_config next = instanceConfig(model_.get(), s.step), now = instance_->config();
   const bool same = next.integrator == now.integrator && next.time_step == now.time_step &&
                     next.newton_iterations == now.newton_iterations && next.rayleigh_alpha == now.rayleigh_alpha &&
-                    next.rayleigh_beta == now.rayleigh_beta && next.linear == now.linear && next.warping == now.warping;
+                    next.rayleigh_beta == now.rayleigh_beta && next.elasticity == now.elasticity;
   std::vector<double> q, v;  // the state a new instance continues from
   if (!same) {
     auto replacement = std::make_unique<RuntimeInstance>(model_, next);  // throws before anything changes
@@ -64,7 +49,7 @@ void ViewSession::configure(const ViewSettings& wanted) {
 }
 
 void ViewSession::applyLoads() {
-  const double g[3] = {0, 0, settings_.gravity ? -9.81 : 0};
+  const double g[3] = {0, 0, settings_.gravity ? -kGravity : 0};
   qv_instance_set_gravity(instance_->get(), g);
   if (grabbed_ >= 0) {
     qv_instance_set_constraint(instance_->get(), 0, &grabbed_, 1, grabTarget_.data(), settings_.springStiffness);

@@ -10,19 +10,16 @@
 
 #include "apps/support/reduced_modes.h"
 #include "apps/support/runtime_model.h"
+#include "apps/support/step_settings.h"
 #include "apps/view/surface_pick.h"
 
 namespace quiver::app {
 
-enum class Elasticity { StVK = 0, Linear = 1, Warping = 2 };
 enum class ModeKind { None = 0, LinearMode = 1, BasisVector = 2 };
 
 struct ViewSettings {
-  qv_integrator integrator = QV_INTEGRATOR_IMPLICIT_NEWMARK;
-  Elasticity elasticity = Elasticity::StVK;
-  double timeStep = 0;           // s; 0: the model's
-  int newtonIterations = 2;      // one is the paper's default, two keep a stiff mouse spring converged
-  double alpha = -1, beta = -1;  // Rayleigh damping; negative: the model's
+  // Two Newton iterations, not the paper's one: they keep a stiff mouse spring converged.
+  StepSettings step{QV_INTEGRATOR_IMPLICIT_NEWMARK, QV_ELASTICITY_STVK, 0, 2, -1, -1};
   bool gravity = false;
   double springStiffness = 0;    // N/m of the mouse spring; 0: scaled to the model (see ViewSession)
 

@@ -41,6 +41,11 @@ enum SectionType : uint32_t {
   kTets = 9,             // optional: readers need not have it
   kModalRotations = 10,  // optional (written with the optional flag, so 1.0 readers skip it)
 };
+constexpr uint32_t kLastKnownType = kModalRotations;
+
+// "MODAL_ROTATIONS", ..., or "section type N" for a type this reader does not know: the one table
+// of names, used by the reader's messages and by `quiver info`.
+std::string sectionName(uint32_t type);
 
 } // namespace qvr
 

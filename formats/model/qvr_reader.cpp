@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <string>
 #include <type_traits>
@@ -18,23 +19,19 @@ namespace quiver {
 static_assert(std::numeric_limits<double>::is_iec559 && sizeof(double) == 8, "float64 must be IEEE binary64");
 static_assert(std::numeric_limits<float>::is_iec559 && sizeof(float) == 4, "float32 must be IEEE binary32");
 
+std::string qvr::sectionName(uint32_t type) {
+  static const char* const kNames[] = {"", "MODEL_INFO", "ENERGY_COEFFICIENTS", "BASIS", "REST_POSITIONS",
+                                       "SURFACE_TRIANGLES", "VERTEX_MAP", "GRAVITY_PROJECTION", "EIGENVALUES", "TETS",
+                                       "MODAL_ROTATIONS"};
+  static_assert(std::size(kNames) == kLastKnownType + 1, "one name for every known section type");
+  return type >= 1 && type <= kLastKnownType ? kNames[type] : "section type " + std::to_string(type);
+}
+
 namespace {
 
 using namespace qvr;
 
-constexpr uint32_t kLastKnownType = kModalRotations;
-
-const char* knownName(uint32_t type) {
-  static const char* const kNames[] = {"", "MODEL_INFO", "ENERGY_COEFFICIENTS", "BASIS", "REST_POSITIONS",
-                                       "SURFACE_TRIANGLES", "VERTEX_MAP", "GRAVITY_PROJECTION", "EIGENVALUES", "TETS",
-                                       "MODAL_ROTATIONS"};
-  return type >= 1 && type <= kLastKnownType ? kNames[type] : nullptr;
-}
-
-std::string sectionName(uint32_t type) {
-  const char* name = knownName(type);
-  return name ? std::string(name) : "section type " + std::to_string(type);
-}
+bool known(uint32_t type) { return type >= 1 && type <= kLastKnownType; }
 
 // Little-endian loads that work on any host.
 uint64_t loadLE(const unsigned char* p, size_t bytes) {
@@ -196,9 +193,9 @@ private:
       if (other->type == s.type)
         return failIn(s, "a second " + sectionName(s.type) + " section (the first is at byte " +
                              std::to_string(other->offset) + ")");
-    if (!knownName(s.type) && !(s.flags & kOptionalSection))
+    if (!known(s.type) && !(s.flags & kOptionalSection))
       return failIn(s, "unknown section type without the optional flag (from a newer version?)");
-    if (knownName(s.type)) byType_[s.type] = &s;
+    if (known(s.type)) byType_[s.type] = &s;
     return true;
   }
 

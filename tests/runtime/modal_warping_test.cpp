@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "formats/model/modal_warping.h"
+#include "quiver/modal_warping.h"
 
 using quiver::warping::warpDisplacement;
 
@@ -49,7 +49,7 @@ double centreLineLength(const quiver::test::BakedModel& m, const std::vector<flo
 std::vector<float> positions(const qv_model* model, const std::vector<double>& q, bool warping) {
   qv_instance_config config;
   qv_instance_config_init(&config, model);
-  config.warping = warping ? 1 : 0;
+  config.elasticity = warping ? QV_ELASTICITY_MODAL_WARPING : QV_ELASTICITY_STVK;
   qv_instance* s = nullptr;
   EXPECT_EQ(qv_instance_create(model, &config, nullptr, &s), QV_OK);
   qv_instance_set_state(s, q.data(), nullptr, nullptr);
@@ -97,7 +97,7 @@ TEST(ModalWarping, StepsWithForcesRotatedIntoTheLocalFrames) {
   ASSERT_NE(m.model, nullptr);
   qv_instance_config config;
   qv_instance_config_init(&config, m.model);
-  config.warping = 1;
+  config.elasticity = QV_ELASTICITY_MODAL_WARPING;
   qv_instance* s = nullptr;
   ASSERT_EQ(qv_instance_create(m.model, &config, nullptr, &s), QV_OK);
   for (int step = 0; step < 50; ++step) {

@@ -219,7 +219,7 @@ TEST(Step, DragSpringPullsAVertexToItsTarget) {
   EXPECT_NEAR(p[2], X.z(), 1e-4);  // released: back to rest
 }
 
-// Linear modal dynamics (config.linear): the same Newmark scheme on q'' + K(0) q = f, with K(0)
+// Linear modal dynamics (QV_ELASTICITY_LINEAR): the same Newmark scheme on q'' + K(0) q = f, with K(0)
 // taken from the full-space FEM; and, unlike StVK, a stretch that grows with the load squared
 // is absent: doubling the load doubles the response exactly.
 TEST(Step, LinearModalDynamicsIsExactlyLinear) {
@@ -228,7 +228,7 @@ TEST(Step, LinearModalDynamicsIsExactlyLinear) {
   const int r = m.info.r, tip = m.tipVertex();
   qv_instance_config config;
   qv_instance_config_init(&config, m.model);
-  config.linear = 1;
+  config.elasticity = QV_ELASTICITY_LINEAR;
   config.rayleigh_alpha = config.rayleigh_beta = 0;
   const double h = config.time_step;
   Eigen::VectorXd zero = Eigen::VectorXd::Zero(r), R;

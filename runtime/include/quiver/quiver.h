@@ -16,7 +16,7 @@ extern "C" {
 #endif
 
 #define QV_VERSION_MAJOR 0
-#define QV_VERSION_MINOR 1
+#define QV_VERSION_MINOR 2
 #define QV_VERSION_PATCH 0
 #define QV_VERSION_NUMBER (QV_VERSION_MAJOR * 10000 + QV_VERSION_MINOR * 100 + QV_VERSION_PATCH)
 
@@ -122,8 +122,28 @@ QV_API qv_result qv_model_displacements(const qv_model* model, const double* q, 
 typedef enum qv_integrator {
   QV_INTEGRATOR_IMPLICIT_NEWMARK = 0, /* beta = 1/4, gamma = 1/2 (Barbic & James 2005); unconditionally stable */
   QV_INTEGRATOR_BACKWARD_EULER = 1,   /* implicit, first order, numerically damped */
-  QV_INTEGRATOR_CENTRAL_DIFFERENCES = 2 /* explicit; stable below qv_instance_stable_time_step() */
+  QV_INTEGRATOR_CENTRAL_DIFFERENCES = 2, /* explicit; stable below qv_instance_stable_time_step() */
+  QV_INTEGRATOR_COUNT
 } qv_integrator;
+
+typedef enum qv_elasticity {
+  QV_ELASTICITY_STVK = 0,          /* the baked St.Venant-Kirchhoff polynomial R(q) */
+  QV_ELASTICITY_LINEAR = 1,        /* linear modal dynamics R(q) = K(0) q in the same subspace (small strains) */
+  QV_ELASTICITY_MODAL_WARPING = 2, /* modal warping (Choi & Ko 2005): linear dynamics, each vertex's displacement
+                                      rotated by its local rotation, forces rotated into the local frames; needs a
+                                      model with modal rotations */
+  QV_ELASTICITY_COUNT
+} qv_elasticity;
+
+/* Each choice has one short name, for options and files ("newmark", "euler", "central"; "stvk", "linear",
+   "warping"), and a description for menus; both NULL out of range. *_from_name sets *value and returns QV_OK, or
+   returns QV_ERROR_INVALID_ARGUMENT for a name it does not know. */
+QV_API const char* qv_integrator_name(qv_integrator integrator);
+QV_API const char* qv_integrator_description(qv_integrator integrator);
+QV_API qv_result qv_integrator_from_name(const char* name, qv_integrator* integrator);
+QV_API const char* qv_elasticity_name(qv_elasticity elasticity);
+QV_API const char* qv_elasticity_description(qv_elasticity elasticity);
+QV_API qv_result qv_elasticity_from_name(const char* name, qv_elasticity* elasticity);
 
 typedef struct qv_instance_config {
   qv_integrator integrator;  /* default QV_INTEGRATOR_IMPLICIT_NEWMARK */
@@ -133,11 +153,7 @@ typedef struct qv_instance_config {
   double rayleigh_beta;      /* s, >= 0; default: the model's */
   int max_constraints;       /* penalty constraint slots (drag springs, pinned groups), 0..64; default 4 */
   double max_displacement;   /* m; a step that moves a vertex farther resets the instance; default 100 x the model's diagonal */
-  int linear;                /* non-zero: linear modal dynamics, R(q) = K(0) q (small-strain elasticity in the same
-                                subspace, for comparison); default 0: St.Venant-Kirchhoff */
-  int warping;               /* non-zero: modal warping (Choi & Ko 2005): linear dynamics, each vertex's displacement
-                                rotated by its local rotation, forces rotated into the local frames; needs a model
-                                with modal rotations; default 0 */
+  qv_elasticity elasticity;  /* default QV_ELASTICITY_STVK */
 } qv_instance_config;
 
 /* Defaults for `model` (pass NULL for model-independent defaults). */

@@ -37,7 +37,7 @@ TEST_F(ViewSessionTest, DropsTimeItCannotCatchUpInsteadOfSpiralling) {
 
 TEST_F(ViewSessionTest, TheSpringPullsTheGrabbedVertexTowardItsTarget) {
   ViewSettings damped;
-  damped.alpha = 20;  // about critical for the first mode: the tip settles within the test's 2 s
+  damped.step.alpha = 20;  // about critical for the first mode: the tip settles within the test's 2 s
   ViewSession session(model, damped);
   std::vector<float> x;
   session.positions(x);
@@ -106,8 +106,8 @@ TEST_F(ViewSessionTest, NewSettingsContinueFromTheSameState) {
   session.advance(20 * h());
   std::vector<float> before, after;
   session.positions(before);
-  settings.integrator = QV_INTEGRATOR_BACKWARD_EULER;
-  settings.timeStep = h() / 2;
+  settings.step.integrator = QV_INTEGRATOR_BACKWARD_EULER;
+  settings.step.timeStep = h() / 2;
   session.configure(settings);
   EXPECT_EQ(session.config().integrator, QV_INTEGRATOR_BACKWARD_EULER);
   EXPECT_EQ(session.config().time_step, h() / 2);
@@ -131,7 +131,7 @@ TEST_F(ViewSessionTest, NewSettingsContinueFromTheSameState) {
   qv_instance_step(b.get());
   EXPECT_EQ(after, b.positions());
 
-  settings.newtonIterations = 0;
+  settings.step.newton = 0;
   EXPECT_THROW(session.configure(settings), std::runtime_error);
   EXPECT_EQ(session.config().newton_iterations, 2) << "refused settings leave the old ones";
 }

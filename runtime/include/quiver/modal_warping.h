@@ -4,7 +4,9 @@
 // space) is moved by the rotation grown from 0 to w along the deformation, integrated:
 //   u = (I + (1 - cos t)/t^2 [w]x + (t - sin t)/t^3 [w]x^2) d,   t = |w|,
 // which tends to d for small w and keeps lengths when d is itself the linear image w x X of a
-// rotation. Standard library only: the runtime and the full-space simulator both use it.
+// rotation. Header-only C++, standard library only: the runtime steps with it, the full-space
+// reference (common/) warps with the same formula, and an engine that warps on its own (in a
+// shader, say) can include it.
 #include <cmath>
 
 namespace quiver::warping {

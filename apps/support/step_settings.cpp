@@ -1,0 +1,55 @@
+#include "apps/support/step_settings.h"
+
+#include <vector>
+
+namespace quiver::app {
+
+namespace {
+
+// An option whose values are the names a runtime table gives, "name (description)" in --help.
+template <class Enum>
+CLI::Option* addChoice(CLI::App& app, const std::string& flag, Enum& target, int count, const char* (*name)(Enum),
+                       const char* (*description)(Enum), qv_result (*fromName)(const char*, Enum*)) {
+  std::vector<std::string> names;
+  std::string help;
+  for (int i = 0; i < count; ++i) {
+    names.push_back(name(Enum(i)));
+    help += std::string(i == 0 ? "" : i + 1 == count ? " or " : ", ") + name(Enum(i)) + " (" + description(Enum(i)) + ")";
+  }
+  return app
+      .add_option_function<std::string>(
+          flag, [&target, fromName](const std::string& value) { fromName(value.c_str(), &target); }, help)
+      ->default_str(name(target))
+      ->check(CLI::IsMember(names));
+}
+
+} // namespace
+
+bool StepSettings::operator==(const StepSettings& o) const {
+  return integrator == o.integrator && elasticity == o.elasticity && timeStep == o.timeStep && newton == o.newton &&
+         alpha == o.alpha && beta == o.beta;
+}
+
+qv_instance_config instanceConfig(const qv_model* model, const StepSettings& s) {
+  qv_instance_config c;
+  qv_instance_config_init(&c, model);
+  c.integrator = s.integrator;
+  c.elasticity = s.elasticity;
+  if (s.timeStep > 0) c.time_step = s.timeStep;
+  c.newton_iterations = s.newton;
+  if (s.alpha >= 0) c.rayleigh_alpha = s.alpha;
+  if (s.beta >= 0) c.rayleigh_beta = s.beta;
+  return c;
+}
+
+CLI::Option* addIntegratorOption(CLI::App& app, qv_integrator& integrator) {
+  return addChoice(app, "--integrator", integrator, QV_INTEGRATOR_COUNT, qv_integrator_name, qv_integrator_description,
+                   qv_integrator_from_name);
+}
+
+CLI::Option* addElasticityOption(CLI::App& app, qv_elasticity& elasticity) {
+  return addChoice(app, "--elasticity", elasticity, QV_ELASTICITY_COUNT, qv_elasticity_name, qv_elasticity_description,
+                   qv_elasticity_from_name);
+}
+
+} // namespace quiver::app

@@ -1,0 +1,33 @@
+#pragma once
+// How the tools step a runtime instance, and the one place in apps/ that maps the runtime's
+// choices to names (taken from the runtime's own tables: qv_integrator_name, qv_elasticity_name)
+// and builds a qv_instance_config: quiver sim, quiver render and the viewer all come here.
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "quiver/quiver.h"
+
+namespace quiver::app {
+
+struct StepSettings {
+  qv_integrator integrator = QV_INTEGRATOR_IMPLICIT_NEWMARK;
+  qv_elasticity elasticity = QV_ELASTICITY_STVK;
+  double timeStep = 0;           // s; 0: the model's
+  int newton = 1;                // Newton iterations per implicit step
+  double alpha = -1, beta = -1;  // Rayleigh damping; negative: the model's
+
+  bool operator==(const StepSettings& o) const;
+};
+
+// The gravity the tools apply (--gravity, the viewer's checkbox): m/s^2, along -z.
+inline constexpr double kGravity = 9.81;
+
+// The model's defaults, overridden where `settings` says.
+qv_instance_config instanceConfig(const qv_model* model, const StepSettings& settings);
+
+// --integrator and --elasticity: a value is one of the runtime's names, stored as the enum.
+CLI::Option* addIntegratorOption(CLI::App& app, qv_integrator& integrator);
+CLI::Option* addElasticityOption(CLI::App& app, qv_elasticity& elasticity);
+
+} // namespace quiver::app

@@ -1,0 +1,314 @@
+// The C API: argument checks, then one call into the runtime's parts (model, instance, loads,
+// integrators, elasticity, output). Nothing here computes.
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "elasticity.h"
+#include "instance.h"
+#include "integrators/integrator.h"
+#include "model.h"
+#include "output.h"
+#include "quiver/quiver.h"
+
+#define QV_STR2(x) #x
+#define QV_STR(x) QV_STR2(x)
+
+namespace {
+
+using namespace quiver::rt;
+
+void* heapAllocate(size_t size, size_t alignment, void*) {
+  void* p = nullptr;
+  return posix_memalign(&p, alignment < sizeof(void*) ? sizeof(void*) : alignment, size) == 0 ? p : nullptr;
+}
+void heapRelease(void* p, void*) { std::free(p); }
+
+qv_allocator allocatorOr(const qv_allocator* allocator) {
+  if (allocator) return *allocator;
+  qv_allocator heap;
+  qv_allocator_init(&heap);
+  return heap;
+}
+
+void report(char* message, size_t size, const std::string& text) {
+  if (message && size > 0) std::snprintf(message, size, "%s", text.c_str());
+}
+
+bool validVertex(const qv_instance* s, int vertex) { return vertex >= 0 && vertex < s->model->info.vertex_count; }
+
+bool validVertices(const qv_instance* s, const int* vertices, int count) {
+  for (int k = 0; k < count; ++k)
+    if (!validVertex(s, vertices[k])) return false;
+  return true;
+}
+
+template <class Table, class Enum>
+qv_result fromName(const Table& table, const char* name, Enum* out) {
+  if (!name || !out) return QV_ERROR_INVALID_ARGUMENT;
+  for (const auto& entry : table)
+    if (std::strcmp(entry.name, name) == 0) {
+      *out = entry.id;
+      return QV_OK;
+    }
+  return QV_ERROR_INVALID_ARGUMENT;
+}
+
+} // namespace
+
+extern "C" {
+
+const char* qv_version_string(void) {
+  return QV_STR(QV_VERSION_MAJOR) "." QV_STR(QV_VERSION_MINOR) "." QV_STR(QV_VERSION_PATCH);
+}
+
+int qv_check_version(int version_number, size_t model_info_size, size_t instance_config_size) {
+  return version_number == QV_VERSION_NUMBER && model_info_size == sizeof(qv_model_info) &&
+         instance_config_size == sizeof(qv_instance_config);
+}
+
+const char* qv_result_string(qv_result result) {
+  switch (result) {
+    case QV_OK: return "ok";
+    case QV_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case QV_ERROR_IO: return "input/output error";
+    case QV_ERROR_FORMAT: return "invalid model file";
+    case QV_ERROR_OUT_OF_MEMORY: return "out of memory";
+  }
+  return "unknown result";
+}
+
+const char* qv_integrator_name(qv_integrator i) {
+  return i >= 0 && i < QV_INTEGRATOR_COUNT ? kIntegrators[i].name : nullptr;
+}
+const char* qv_integrator_description(qv_integrator i) {
+  return i >= 0 && i < QV_INTEGRATOR_COUNT ? kIntegrators[i].description : nullptr;
+}
+qv_result qv_integrator_from_name(const char* name, qv_integrator* integrator) {
+  return fromName(kIntegrators, name, integrator);
+}
+const char* qv_elasticity_name(qv_elasticity e) {
+  return e >= 0 && e < QV_ELASTICITY_COUNT ? kElasticities[e].name : nullptr;
+}
+const char* qv_elasticity_description(qv_elasticity e) {
+  return e >= 0 && e < QV_ELASTICITY_COUNT ? kElasticities[e].description : nullptr;
+}
+qv_result qv_elasticity_from_name(const char* name, qv_elasticity* elasticity) {
+  return fromName(kElasticities, name, elasticity);
+}
+
+// ---- Models ----
+
+void qv_model_config_init(qv_model_config* config) {
+  if (config) config->coefficient_precision = 64;
+}
+
+void qv_allocator_init(qv_allocator* allocator) {
+  if (allocator) *allocator = qv_allocator{heapAllocate, heapRelease, nullptr};
+}
+
+qv_result qv_model_load_memory(const void* data, size_t size, const qv_model_config* config,
+                               const qv_allocator* allocator, qv_model** model, char* message, size_t message_size) {
+  if (!model) return QV_ERROR_INVALID_ARGUMENT;
+  *model = nullptr;
+  qv_model_config defaults;
+  qv_model_config_init(&defaults);
+  const qv_model_config& settings = config ? *config : defaults;
+  if ((!data && size) || (settings.coefficient_precision != 32 && settings.coefficient_precision != 64))
+    return QV_ERROR_INVALID_ARGUMENT;
+  const qv_allocator use = allocatorOr(allocator);
+  // The reader wants an 8-byte aligned image; a caller's buffer may not be.
+  void* aligned = nullptr;
+  if (reinterpret_cast<uintptr_t>(data) % 8 != 0) {
+    aligned = use.allocate(size ? size : 1, 64, use.user);
+    if (!aligned) return QV_ERROR_OUT_OF_MEMORY;
+    std::memcpy(aligned, data, size);
+    data = aligned;
+  }
+  const qv_result result = loadModel(data, size, settings, use, model, message, message_size);
+  if (aligned) use.release(aligned, use.user);
+  return result;
+}
+
+qv_result qv_model_load_file(const char* path, const qv_model_config* config, const qv_allocator* allocator,
+                             qv_model** model, char* message, size_t message_size) {
+  if (!model || !path) return QV_ERROR_INVALID_ARGUMENT;
+  *model = nullptr;
+  const qv_allocator use = allocatorOr(allocator);
+  FILE* file = std::fopen(path, "rb");
+  if (!file) {
+    report(message, message_size, std::string(path) + ": cannot open: " + std::strerror(errno));
+    return QV_ERROR_IO;
+  }
+  std::fseek(file, 0, SEEK_END);
+  const long length = std::ftell(file);
+  std::fseek(file, 0, SEEK_SET);
+  if (length < 0) {
+    std::fclose(file);
+    report(message, message_size, std::string(path) + ": cannot read its size");
+    return QV_ERROR_IO;
+  }
+  void* buffer = use.allocate(length ? static_cast<size_t>(length) : 1, 64, use.user);
+  if (!buffer) {
+    std::fclose(file);
+    return QV_ERROR_OUT_OF_MEMORY;
+  }
+  const bool complete = std::fread(buffer, 1, static_cast<size_t>(length), file) == static_cast<size_t>(length);
+  std::fclose(file);
+  qv_result result = QV_ERROR_IO;
+  if (!complete) {
+    report(message, message_size, std::string(path) + ": read error");
+  } else {
+    char inner[512] = "";
+    result = qv_model_load_memory(buffer, static_cast<size_t>(length), config, &use, model, inner, sizeof inner);
+    if (result != QV_OK) report(message, message_size, std::string(path) + ": " + inner);
+  }
+  use.release(buffer, use.user);
+  return result;
+}
+
+void qv_model_destroy(qv_model* model) {
+  if (model) destroyModel(model);
+}
+
+void qv_model_get_info(const qv_model* model, qv_model_info* info) {
+  if (model && info) *info = model->info;
+}
+
+size_t qv_model_scratch_size(const qv_model* model) {
+  return model ? ReducedPolynomial::scratchSize(model->info.r) * sizeof(double) : 0;
+}
+
+qv_result qv_model_evaluate(const qv_model* model, const double* q, double* energy, double* force, double* stiffness,
+                            void* scratch) {
+  if (!model || !q || !scratch || reinterpret_cast<uintptr_t>(scratch) % alignof(double) != 0)
+    return QV_ERROR_INVALID_ARGUMENT;
+  model->polynomial.evaluate(q, energy, force, stiffness, static_cast<double*>(scratch));
+  return QV_OK;
+}
+
+qv_result qv_model_displacements(const qv_model* model, const double* q, float* out) {
+  if (!model || !q || !out) return QV_ERROR_INVALID_ARGUMENT;
+  displacements(*model, q, out);
+  return QV_OK;
+}
+
+const double* qv_model_rest_positions(const qv_model* model) { return model ? model->rest : nullptr; }
+const unsigned* qv_model_triangles(const qv_model* model) { return model ? model->triangles : nullptr; }
+const unsigned* qv_model_vertex_map(const qv_model* model) { return model ? model->vertexMap : nullptr; }
+const double* qv_model_eigenvalues(const qv_model* model) { return model ? model->eigenvalues : nullptr; }
+const double* qv_model_gravity(const qv_model* model) { return model ? model->gravity : nullptr; }
+
+void qv_model_surface_normals(const qv_model* model, const float* positions, float* normals) {
+  if (model && positions && normals) surfaceNormals(*model, positions, normals);
+}
+
+// ---- Instances ----
+
+void qv_instance_config_init(qv_instance_config* config, const qv_model* model) {
+  if (config) defaultConfig(*config, model);
+}
+
+size_t qv_instance_memory_requirements(const qv_model* model, const qv_instance_config* config) {
+  return validConfig(model, config) ? instanceBytes(*model, *config) : 0;
+}
+
+qv_result qv_instance_create_in_place(const qv_model* model, const qv_instance_config* config, void* memory,
+                                      size_t size, qv_instance** instance) {
+  if (!instance) return QV_ERROR_INVALID_ARGUMENT;
+  *instance = nullptr;
+  if (!validConfig(model, config) || !memory || reinterpret_cast<uintptr_t>(memory) % 64 != 0 ||
+      size < instanceBytes(*model, *config))
+    return QV_ERROR_INVALID_ARGUMENT;
+  *instance = constructInstance(*model, *config, static_cast<char*>(memory));
+  (*instance)->ownsMemory = false;
+  return QV_OK;
+}
+
+qv_result qv_instance_create(const qv_model* model, const qv_instance_config* config, const qv_allocator* allocator,
+                             qv_instance** instance) {
+  if (!instance) return QV_ERROR_INVALID_ARGUMENT;
+  *instance = nullptr;
+  if (!validConfig(model, config)) return QV_ERROR_INVALID_ARGUMENT;
+  const qv_allocator use = allocatorOr(allocator);
+  char* block = static_cast<char*>(use.allocate(instanceBytes(*model, *config), 64, use.user));
+  if (!block) return QV_ERROR_OUT_OF_MEMORY;
+  *instance = constructInstance(*model, *config, block);
+  (*instance)->allocator = use;
+  (*instance)->ownsMemory = true;
+  return QV_OK;
+}
+
+void qv_instance_destroy(qv_instance* s) {
+  if (!s || !s->ownsMemory) return;
+  const qv_allocator allocator = s->allocator;
+  s->~qv_instance();
+  allocator.release(s, allocator.user);
+}
+
+qv_step_status qv_instance_step(qv_instance* s) { return s->step(); }
+
+qv_result qv_instance_add_vertex_force(qv_instance* s, int vertex, const double force[3]) {
+  if (!s || !force || !validVertex(s, vertex)) return QV_ERROR_INVALID_ARGUMENT;
+  s->loads.addVertexForce(*s->model, s->config.elasticity, s->q, vertex, force);
+  return QV_OK;
+}
+
+qv_result qv_instance_add_reduced_force(qv_instance* s, const double* force) {
+  if (!s || !force) return QV_ERROR_INVALID_ARGUMENT;
+  s->loads.addReducedForce(force);
+  return QV_OK;
+}
+
+void qv_instance_set_gravity(qv_instance* s, const double g[3]) {
+  if (s && g) s->loads.setGravity(*s->model, g);
+}
+
+qv_result qv_instance_set_constraint(qv_instance* s, int slot, const int* vertices, int count, const double* targets,
+                                     double stiffness) {
+  if (!s || slot < 0 || slot >= s->config.max_constraints || count < 1 || !vertices || !targets || !(stiffness > 0) ||
+      !validVertices(s, vertices, count))
+    return QV_ERROR_INVALID_ARGUMENT;
+  s->loads.setConstraint(*s->model, slot, vertices, count, targets, stiffness);
+  return QV_OK;
+}
+
+void qv_instance_clear_constraint(qv_instance* s, int slot) {
+  if (s && slot >= 0 && slot < s->config.max_constraints) s->loads.clearConstraint(slot);
+}
+
+void qv_instance_get_state(const qv_instance* s, double* q, double* v, double* a) {
+  if (!s) return;
+  if (q) std::memcpy(q, s->q, sizeof(double) * s->r);
+  if (v) std::memcpy(v, s->v, sizeof(double) * s->r);
+  if (a) std::memcpy(a, s->a, sizeof(double) * s->r);
+}
+
+void qv_instance_set_state(qv_instance* s, const double* q, const double* v, const double* a) {
+  if (s) s->setState(q, v, a);
+}
+
+void qv_instance_reset(qv_instance* s) {
+  if (s) s->rest();
+}
+
+void qv_instance_energies(const qv_instance* s, double* kinetic, double* elastic) {
+  if (s) s->energies(kinetic, elastic);
+}
+
+double qv_instance_stable_time_step(const qv_instance* s) { return s ? s->model->stableStep : 0; }
+
+void qv_instance_positions(const qv_instance* s, float* out) {
+  if (s && out) positions(*s, out);
+}
+
+qv_result qv_instance_positions_of(const qv_instance* s, const int* vertices, int count, float* out) {
+  if (!s || !vertices || !out || count < 0 || !validVertices(s, vertices, count)) return QV_ERROR_INVALID_ARGUMENT;
+  positionsOf(*s, vertices, count, out);
+  return QV_OK;
+}
+
+} // extern "C"

@@ -1,0 +1,25 @@
+#pragma once
+// The equations of motion M q'' + C q' + R(q) + S(q) = f at a trial state, as the integrators use
+// them (M = I: the basis is mass-orthonormal; C = alpha I + beta K(q), Rayleigh; S the state
+// forces of loads.h, Jacobian J): forces, damping, and the Newton system
+//   (I + c1 C + c2 (K + J)) x = rhs.
+#include "instance.h"
+
+namespace quiver::rt {
+
+// Fills s.work.force = R(q) + S(q) and s.work.stiffness = K(q); returns J.
+const double* evaluateForces(qv_instance& s, const double* q);
+
+// (C v)_i with the elastic stiffness last evaluated.
+inline double dampingForce(const qv_instance& s, int i, const double* v) {
+  double d = s.config.rayleigh_alpha * v[i];
+  for (int j = 0; j < s.r; ++j) d += s.config.rayleigh_beta * s.work.stiffness[i * s.r + j] * v[j];
+  return d;
+}
+
+// Solves the Newton system for the right-hand side in s.work.correction (the correction replaces
+// it): Cholesky, or pivoting LU (QV_STEP_INDEFINITE) when large compression has made the matrix
+// indefinite; QV_STEP_RESET when it is singular.
+qv_step_status solveNewton(qv_instance& s, const double* stateJacobian, double c1, double c2);
+
+} // namespace quiver::rt

@@ -1,0 +1,57 @@
+#pragma once
+// qv_instance: one simulated object, in one block: its settings, its state (q, v, a), its loads
+// and the buffers of the step. Integrators (integrators/) advance it; dynamics.h evaluates it.
+#include "block_carver.h"
+#include "loads.h"
+#include "model.h"
+
+namespace quiver::rt {
+
+// The integrator's estimate of the state at the end of the step: each implicit integrator iterates
+// on one of them and derives the others; the explicit one computes them in turn.
+struct EndOfStep {
+  double* q = nullptr;
+  double* v = nullptr;
+  double* a = nullptr;
+};
+
+// What one evaluation at a trial state fills, and the Newton system built from it.
+struct StepBuffers {
+  double* force = nullptr;        // R(q) plus the state forces (resisting: the step subtracts it)
+  double* stiffness = nullptr;    // K(q), elastic only (Rayleigh damping uses it)
+  double* system = nullptr;       // the Newton matrix, factorised in place
+  double* correction = nullptr;   // the Newton right-hand side in, the correction out
+  double* retryRhs = nullptr;     // the right-hand side kept for the LU retry
+  int* pivot = nullptr;           // LU's row exchanges
+  double* polynomialScratch = nullptr;
+};
+
+// Bytes of the block an instance with `config` needs (64-byte aligned).
+size_t instanceBytes(const qv_model& model, const qv_instance_config& config);
+bool validConfig(const qv_model* model, const qv_instance_config* config);
+// Builds the instance at rest, with no loads, in `block` (instanceBytes() bytes).
+qv_instance* constructInstance(const qv_model& model, const qv_instance_config& config, char* block);
+void defaultConfig(qv_instance_config& config, const qv_model* model);
+
+} // namespace quiver::rt
+
+struct qv_instance {
+  const qv_model* model;
+  qv_allocator allocator;
+  bool ownsMemory;
+  qv_instance_config config;
+  int r;
+  double maxQ;  // |q|_inf beyond which the state counts as blown up
+  double *q, *v, *a;
+  quiver::rt::Loads loads;
+  quiver::rt::EndOfStep end;
+  quiver::rt::StepBuffers work;
+
+  void carve(quiver::rt::BlockCarver& c);
+  void rest();
+  bool healthy() const;
+  // One step of the configured integrator; per-step loads are spent; a blown-up state resets.
+  qv_step_status step();
+  void setState(const double* q, const double* v, const double* a);
+  void energies(double* kinetic, double* elastic) const;
+};

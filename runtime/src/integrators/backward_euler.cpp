@@ -1,0 +1,35 @@
+// Backward Euler: Newton on the end-of-step velocity, starting from the current one. First order
+// and numerically damped.
+#include <cstring>
+
+#include "../dynamics.h"
+#include "integrator.h"
+
+namespace quiver::rt {
+
+qv_step_status stepBackwardEuler(qv_instance& s) {
+  const double h = s.config.time_step;
+  const int r = s.r;
+  double *q = s.q, *v = s.v, *a = s.a;
+  std::memcpy(s.end.v, v, sizeof(double) * r);
+  qv_step_status status = QV_STEP_OK;
+  for (int it = 0; it < s.config.newton_iterations; ++it) {
+    for (int i = 0; i < r; ++i) s.end.q[i] = q[i] + h * s.end.v[i];
+    const double* J = evaluateForces(s, s.end.q);
+    for (int i = 0; i < r; ++i)
+      s.work.correction[i] =
+          -((s.end.v[i] - v[i]) + h * (dampingForce(s, i, s.end.v) + s.work.force[i] - s.loads.external(i)));
+    const qv_step_status solved = solveNewton(s, J, h, h * h);
+    if (solved == QV_STEP_RESET) return solved;
+    if (solved == QV_STEP_INDEFINITE) status = solved;
+    for (int i = 0; i < r; ++i) s.end.v[i] += s.work.correction[i];
+  }
+  for (int i = 0; i < r; ++i) {
+    a[i] = (s.end.v[i] - v[i]) / h;
+    v[i] = s.end.v[i];
+    q[i] += h * v[i];
+  }
+  return status;
+}
+
+} // namespace quiver::rt

@@ -1,0 +1,23 @@
+#pragma once
+// Time integrators. Each lives in its own file as one function that advances an instance by one
+// step; adding one means its file, a value of qv_integrator and a row of kIntegrators.
+#include "../instance.h"
+
+namespace quiver::rt {
+
+using StepFunction = qv_step_status (*)(qv_instance&);
+
+struct IntegratorEntry {
+  qv_integrator id;
+  const char* name;
+  const char* description;
+  StepFunction step;
+};
+// Indexed by qv_integrator: the one table of names.
+extern const IntegratorEntry kIntegrators[QV_INTEGRATOR_COUNT];
+
+qv_step_status stepImplicitNewmark(qv_instance& s);
+qv_step_status stepBackwardEuler(qv_instance& s);
+qv_step_status stepCentralDifferences(qv_instance& s);
+
+} // namespace quiver::rt

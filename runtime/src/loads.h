@@ -1,0 +1,53 @@
+#pragma once
+// The world's forces on one instance, in reduced coordinates (f = U^T f_world):
+// - per-step forces (on a vertex, or already reduced), cleared by every step;
+// - gravity G g, persistent;
+// - penalty constraints in slots, k/2 |X_v + U_v q - target_v|^2 per vertex, persistent: the
+//   mouse spring, or a group held at targets the caller moves (drag and twist).
+//
+// State-dependent forces. The implicit step needs, at every trial q, the forces that depend on
+// the state and their Jacobian; addStateForces() is the one place they come from. It adds their
+// resisting force (the sign of R(q): the step subtracts it) to `force` and returns the Jacobian of
+// what it added, which the Newton system adds to the elastic stiffness (Rayleigh damping stays
+// elastic only). Penalty constraints are linear in q, so their Jacobian is the constant sum of
+// the active slots and is returned as it is. A term whose Jacobian depends on q (contact) writes
+// that sum plus its own into a buffer it owns and returns the buffer; a term that also depends on
+// the velocity (contact damping, friction) adds its velocity Jacobian to the c1 part of the system.
+#include "block_carver.h"
+#include "model.h"
+
+namespace quiver::rt {
+
+struct Loads {
+  int r = 0;
+  int slots = 0;
+  double* stepForce = nullptr;     // this step's only
+  double* gravityForce = nullptr;  // G g
+  double* constraintK = nullptr;   // sum over active slots of k U_v^T U_v
+  double* constraintB = nullptr;   // sum over active slots of k U_v^T (target - X_v)
+  double* slotK = nullptr;         // per slot
+  double* slotB = nullptr;
+  int* slotActive = nullptr;
+
+  // Takes the arrays from `c` (null pointers while it measures).
+  void carve(BlockCarver& c, int reducedSize, int slotCount);
+  void clear();  // nothing acting
+
+  double external(int i) const { return stepForce[i] + gravityForce[i]; }
+  const double* addStateForces(const double* q, double* force) const;
+  void endStep();  // the per-step forces are spent
+
+  // `q`: the current state, to rotate the force into the vertex's frame under modal warping.
+  void addVertexForce(const qv_model& model, qv_elasticity elasticity, const double* q, int vertex,
+                      const double force[3]);
+  void addReducedForce(const double* force);
+  void setGravity(const qv_model& model, const double acceleration[3]);
+  void setConstraint(const qv_model& model, int slot, const int* vertices, int count, const double* targets,
+                     double stiffness);
+  void clearConstraint(int slot);
+
+private:
+  void combineConstraints();
+};
+
+} // namespace quiver::rt

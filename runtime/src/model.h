@@ -1,0 +1,41 @@
+#pragma once
+// qv_model: a baked model in one block from the caller's allocator, immutable once loaded and
+// shared read-only by every instance of it.
+#include <cstddef>
+
+#include "quiver/quiver.h"
+#include "reduced_polynomial.h"
+
+struct qv_model {
+  qv_allocator allocator;
+  qv_model_info info;
+  quiver::rt::ReducedPolynomial polynomial;
+  const float* basis32;   // 3n x r row-major, or null
+  const double* basis64;  // 3n x r row-major, or null
+  const double* rest;
+  const unsigned* triangles;
+  const unsigned* vertexMap;
+  const double* gravity;
+  const double* eigenvalues;
+  const double* rotations;      // 3n x r row-major modal rotations, or null
+  const double* restStiffness;  // K(0), r x r: linear modal dynamics and modal warping step with it
+  double stableStep;            // 2 / omega_max of K(0): central differences' limit
+
+  double basisEntry(size_t row, size_t j) const {
+    const size_t r = static_cast<size_t>(info.r);
+    return basis32 ? static_cast<double>(basis32[row * r + j]) : basis64[row * r + j];
+  }
+  // Vertex v's linear displacement U_v q and, when `w` is not null, its modal rotation Psi_v q.
+  void vertexLinear(int v, const double* q, double d[3], double w[3]) const;
+};
+
+namespace quiver::rt {
+
+// Parses a .qvr image (8-byte aligned) and builds the model in one block from `allocator`. On a
+// format error returns QV_ERROR_FORMAT with the reader's message in `message`.
+qv_result loadModel(const void* data, size_t size, const qv_model_config& config, const qv_allocator& allocator,
+                    qv_model** model, char* message, size_t messageSize);
+
+void destroyModel(qv_model* model);
+
+} // namespace quiver::rt

@@ -1,0 +1,13 @@
+#pragma once
+// What the caller renders: displacements and positions of the simulated vertices (warped under
+// modal warping) and surface normals, into caller-owned buffers.
+#include "instance.h"
+
+namespace quiver::rt {
+
+void displacements(const qv_model& model, const double* q, float* out);           // U q, 3 per vertex
+void positions(const qv_instance& s, float* out);                                  // all vertices
+void positionsOf(const qv_instance& s, const int* vertices, int count, float* out);  // the listed ones
+void surfaceNormals(const qv_model& model, const float* positions, float* normals);
+
+} // namespace quiver::rt
