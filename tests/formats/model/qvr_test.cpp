@@ -13,7 +13,7 @@
 #include "formats/model/fnv1a.h"
 #include "formats/model/qvr.h"
 #include "formats/model/qvr_writer.h"
-#include "tests/formats/qvr_test_files.h"
+#include "tests/formats/model/qvr_test_files.h"
 #include "tests/support/test_support.h"
 
 namespace quiver {

@@ -5,7 +5,7 @@
 
 #include "formats/mesh/read_mesh.h"
 #include "formats/mesh/write_mesh.h"
-#include "tests/formats/text_mesh_test_support.h"
+#include "tests/formats/mesh/text_mesh_test_support.h"
 
 namespace quiver {
 namespace {

@@ -14,7 +14,7 @@
 
 #include "formats/model/qvr.h"
 #include "formats/model/qvr_writer.h"
-#include "tests/formats/qvr_test_files.h"
+#include "tests/formats/model/qvr_test_files.h"
 
 namespace quiver {
 namespace {

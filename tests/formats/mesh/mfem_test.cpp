@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "formats/mesh/read_mesh.h"
-#include "tests/formats/text_mesh_test_support.h"
+#include "tests/formats/mesh/text_mesh_test_support.h"
 #include "tests/support/test_support.h"
 
 namespace quiver {
