@@ -39,7 +39,7 @@
 
 #include "common/material.h"
 #include "common/tet_mesh.h"
-#include "formats/mesh/mesh_checks.h"
+#include "formats/mesh/read_mesh.h"
 #include "precompute/bake_context.h"
 #include "precompute/stages/partition.h"
 #include "precompute/stages/polynomials.h"

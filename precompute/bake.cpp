@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "formats/atomic_file.h"
+#include "formats/mesh/read_mesh.h"
 #include "formats/npy.h"
 #include "precompute/archive/xdmf.h"
 #include "precompute/checkpoint.h"

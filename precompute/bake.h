@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "common/tet_mesh.h"
-#include "formats/mesh/fixed_vertices.h"
-#include "formats/mesh/mesh_checks.h"
+#include "common/fixed_vertices.h"
+#include "common/mesh_checks.h"
 #include "precompute/bake_context.h"
 #include "precompute/stages/export_model.h"
 

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "common/tet_mesh.h"
-#include "formats/mesh/mesh_checks.h"
+#include "common/mesh_checks.h"
 #include "precompute/archive/archive.h"
 #include "precompute/dof_layout.h"
 #include "precompute/stages/basis.h"

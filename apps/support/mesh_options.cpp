@@ -2,6 +2,11 @@
 
 #include <algorithm>
 #include <iostream>
+#include <sstream>
+
+#include "common/mesh_error.h"
+#include "formats/mesh/read_mesh.h"
+#include "formats/mesh/text_cursor.h"
 
 namespace quiver::app {
 
@@ -23,18 +28,37 @@ CheckedMesh MeshOptions::load(const std::string& tool) const {
 }
 
 void FixedVertexOptions::addTo(CLI::App& app) {
-  app.add_option("--fix", request.selectors,
+  app.add_option("--fix", selectors,
                  "Fix the vertices an expression selects, in mesh units: \"x<0.01\", \"y>=max-1e-3 & z<0.5\", "
                  "\"box:x0,y0,z0,x1,y1,z1\" (repeatable; union)");
   app.add_option("--fix-indices", indexList, "Fix vertices by 0-based number in the file's order: \"0,5,10-20\"");
-  app.add_option("--bou", request.bouFiles, "Fix the vertices listed in a Vega .bou file (1-based; repeatable)")
+  app.add_option("--bou", bouFiles, "Fix the vertices listed in a Vega .bou file (1-based; repeatable)")
       ->check(CLI::ExistingFile);
 }
 
 FixedVertexRequest FixedVertexOptions::resolved() const {
-  FixedVertexRequest r = request;
-  if (!indexList.empty()) r.indices = parseIndexList(indexList, "--fix-indices");
+  FixedVertexRequest r;
+  r.selectors = selectors;
+  if (!indexList.empty()) r.lists.push_back({"--fix-indices", parseIndexList(indexList, "--fix-indices"), 0});
+  for (const std::string& bou : bouFiles) r.lists.push_back(readBouFile(bou));
   return r;
+}
+
+std::vector<int64_t> parseIndexList(const std::string& text, const std::string& what) {
+  std::vector<int64_t> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    size_t dash = item.find('-', 1);
+    int64_t lo, hi;
+    bool ok = dash == std::string::npos ? parseInteger(item, lo) && (hi = lo, true)
+                                        : parseInteger(item.substr(0, dash), lo) && parseInteger(item.substr(dash + 1), hi);
+    if (!ok || lo < 0 || hi < lo || hi - lo > 100000000)
+      throw MeshError(what + ": '" + item + "' is not a vertex index or range like 10-12 (0-based)");
+    for (int64_t i = lo; i <= hi; ++i) out.push_back(i);
+  }
+  if (out.empty()) throw MeshError(what + ": empty index list");
+  return out;
 }
 
 std::vector<int> FixedVertexOptions::select(const CheckedMesh& mesh) const { return selectFixedVertices(mesh, resolved()); }

@@ -5,8 +5,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "formats/mesh/fixed_vertices.h"
-#include "formats/mesh/mesh_checks.h"
+#include "common/fixed_vertices.h"
+#include "common/mesh_checks.h"
 
 namespace quiver::app {
 
@@ -21,16 +21,21 @@ struct MeshOptions {
 };
 
 struct FixedVertexOptions {
-  FixedVertexRequest request;
+  std::vector<std::string> selectors;
   std::string indexList;
+  std::vector<std::string> bouFiles;
 
   // Adds --fix EXPR (repeatable), --fix-indices LIST and --bou FILE (repeatable).
   void addTo(CLI::App& app);
-  bool given() const { return !request.empty() || !indexList.empty(); }
-  // The request with --fix-indices parsed in; throws naming --fix-indices if the list is malformed.
+  bool given() const { return !selectors.empty() || !indexList.empty() || !bouFiles.empty(); }
+  // The request with --fix-indices parsed and the .bou files read; throws naming --fix-indices or
+  // the file and line of what is malformed.
   FixedVertexRequest resolved() const;
   std::vector<int> select(const CheckedMesh& mesh) const;
 };
+
+// Parses "3,7,10-12" (0-based, ranges inclusive) into indices; throws MeshError naming `what`.
+std::vector<int64_t> parseIndexList(const std::string& text, const std::string& what);
 
 // All of `text` as a number (std::stod's syntax); false when it is not one or something follows it.
 bool parseNumber(const std::string& text, double& value);

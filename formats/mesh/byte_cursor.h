@@ -7,7 +7,7 @@
 #include <string_view>
 #include <type_traits>
 
-#include "formats/mesh/mesh_error.h"
+#include "common/mesh_error.h"
 
 namespace quiver {
 

@@ -5,9 +5,10 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
-#include "formats/mesh/mesh_error.h"
+#include "common/mesh_error.h"
 
 namespace quiver {
 
@@ -84,6 +85,16 @@ RawMesh readMeshFile(const std::string& path, MeshFormat format) {
   }
   throw MeshError(path + ": unknown mesh format (extension '" + ext +
                   "'); supported: .node/.ele, .msh, .mesh (Medit or MFEM), .veg, .vtk, .vtu");
+}
+
+CheckedMesh loadMesh(const std::string& path, const MeshCheckOptions& options, MeshFormat format) {
+  return checkMesh(readMeshFile(path, format), options);
+}
+
+FileVertexList readBouFile(const std::string& path) {
+  FileVertexList list{path, {}, 1};
+  for (int v : parseBou(readFileBytes(path), path, std::numeric_limits<int>::max())) list.indices.push_back(v);
+  return list;
 }
 
 } // namespace quiver

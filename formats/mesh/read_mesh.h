@@ -1,23 +1,19 @@
 #pragma once
 // Reading tetrahedral meshes. The parse* functions work on bytes already in memory (tests and
 // fuzzers call them directly); readMeshFile() picks the format from the extension and content.
-// None of them validates geometry: see mesh_checks.h.
+// None of them validates geometry: see common/mesh_checks.h.
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "common/tet_mesh.h"
-#include "formats/mesh/mesh_source.h"
+#include "common/fixed_vertices.h"
+#include "common/mesh_checks.h"
+#include "common/mesh_source.h"
 
 namespace quiver {
 
 enum class MeshFormat { Auto, TetGen, Gmsh, Medit, Mfem, Vega, VtkLegacy, Vtu };
-
-struct RawMesh {
-  TetMesh mesh;
-  MeshSource source;
-  MeshReadReport report;
-};
 
 RawMesh parseGmsh(std::string_view bytes, const std::string& file);   // .msh 2.2 / 4.1, ASCII or binary
 RawMesh parseMedit(std::string_view bytes, const std::string& file);  // .mesh (MeshVersionFormatted, ASCII)
@@ -41,5 +37,13 @@ const char* meshFormatName(MeshFormat f);
 
 // Reads PATH (for TetGen, PATH may name the .node, the .ele or their common stem).
 RawMesh readMeshFile(const std::string& path, MeshFormat format = MeshFormat::Auto);
+
+// readMeshFile() then checkMesh().
+CheckedMesh loadMesh(const std::string& path, const MeshCheckOptions& options = {},
+                     MeshFormat format = MeshFormat::Auto);
+
+// A Vega .bou file as a fixed-vertex list (0-based file vertex numbers); throws MeshError naming
+// the file and line of a malformed number. The range is checked against the mesh later.
+FileVertexList readBouFile(const std::string& path);
 
 } // namespace quiver

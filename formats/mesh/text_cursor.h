@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "formats/mesh/mesh_error.h"
+#include "common/mesh_error.h"
 
 namespace quiver {
 

@@ -4,7 +4,7 @@
 #include <charconv>
 #include <climits>
 
-#include "formats/mesh/mesh_error.h"
+#include "common/mesh_error.h"
 
 namespace quiver::vtk {
 

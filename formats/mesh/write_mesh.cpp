@@ -3,7 +3,7 @@
 #include <filesystem>
 
 #include "formats/atomic_file.h"
-#include "formats/mesh/mesh_error.h"
+#include "common/mesh_error.h"
 
 namespace quiver {
 

@@ -7,7 +7,7 @@
 
 #include <Eigen/Core>
 
-#include "formats/mesh/mesh_checks.h"
+#include "common/mesh_checks.h"
 #include "formats/model/qvr_writer.h"
 #include "precompute/stages/polynomials.h"
 

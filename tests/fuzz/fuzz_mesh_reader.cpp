@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <string_view>
 
-#include "formats/mesh/mesh_checks.h"
-#include "formats/mesh/mesh_error.h"
+#include "common/mesh_checks.h"
+#include "common/mesh_error.h"
 #include "formats/mesh/read_mesh.h"
 
 #define QUIVER_FUZZ_GMSH 1

@@ -6,7 +6,7 @@
 
 #include "common/box_mesh.h"
 #include "common/stvk_force_model.h"
-#include "formats/mesh/mesh_checks.h"
+#include "common/mesh_checks.h"
 #include "precompute/stages/assemble.h"
 #include "precompute/stages/export_model.h"
 #include "precompute/stages/modes.h"

@@ -8,8 +8,8 @@
 #include <limits>
 #include <set>
 
-#include "formats/mesh/mesh_checks.h"
-#include "formats/mesh/mesh_error.h"
+#include "common/mesh_checks.h"
+#include "common/mesh_error.h"
 #include "formats/mesh/read_mesh.h"
 #include "formats/mesh/write_mesh.h"
 #include "tests/support/test_support.h"

@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "common/box_mesh.h"
-#include "formats/mesh/mesh_error.h"
+#include "common/mesh_error.h"
 #include "tests/support/test_support.h"
 
 namespace quiver::test {

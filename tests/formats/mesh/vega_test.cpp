@@ -1,8 +1,10 @@
 // Vega .veg and .bou: the shared beam and bridge, materials/sets/regions, and bad input.
 #include <gtest/gtest.h>
 
-#include "formats/mesh/mesh_checks.h"
-#include "formats/mesh/mesh_error.h"
+#include <fstream>
+
+#include "common/mesh_checks.h"
+#include "common/mesh_error.h"
 #include "formats/mesh/read_mesh.h"
 #include "formats/mesh/write_mesh.h"
 #include "tests/support/test_support.h"
@@ -110,6 +112,19 @@ TEST(BouReader, ParsesOneBasedListsAndRefusesBadNumbers) {
   }
   EXPECT_THROW(parseBou("1,x\n", "f.bou", 5), MeshError);
   EXPECT_THROW(parseBou("0\n", "f.bou", 5), MeshError);
+}
+
+TEST(BouReader, AFileBecomesAOneBasedVertexListNamedByThePath) {
+  const std::string path = test::tempDir("bou_file") + "/fixed.bou";
+  std::ofstream(path) << "# fixed\n4, 2,\n9\n";
+  const FileVertexList list = readBouFile(path);
+  EXPECT_EQ(list.source, path);
+  EXPECT_EQ(list.indices, (std::vector<int64_t>{3, 1, 8}));
+  EXPECT_EQ(list.firstNumber, 1);
+  std::ofstream(path) << "4,\nfour\n";
+  EXPECT_NE(test::errorOf<MeshError>([&] { readBouFile(path); }).find(path + ":2: 'four' is not a vertex number"),
+            std::string::npos);
+  EXPECT_NE(test::errorOf<MeshError>([&] { readBouFile(path + ".missing"); }).find("cannot open"), std::string::npos);
 }
 
 TEST(VegaSharedMeshes, BeamAndBridge) {

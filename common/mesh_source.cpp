@@ -1,4 +1,4 @@
-#include "formats/mesh/mesh_source.h"
+#include "common/mesh_source.h"
 
 namespace quiver {
 

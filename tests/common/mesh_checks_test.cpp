@@ -6,9 +6,9 @@
 #include <fstream>
 
 #include "common/box_mesh.h"
-#include "formats/mesh/fixed_vertices.h"
-#include "formats/mesh/mesh_checks.h"
-#include "formats/mesh/mesh_error.h"
+#include "common/fixed_vertices.h"
+#include "common/mesh_checks.h"
+#include "common/mesh_error.h"
 #include "tests/support/test_support.h"
 
 using namespace quiver;
@@ -114,20 +114,21 @@ TEST(MeshChecks, UnreferencedVerticesAreDroppedAndRemapped) {
 
   // Fixed-vertex indices refer to the file's numbering and follow the remap.
   FixedVertexRequest byIndex;
-  byIndex.indices = {1, 2};
+  byIndex.lists = {{"--fix-indices", {1, 2}, 0}};
   EXPECT_EQ(selectFixedVertices(c, byIndex), (std::vector<int>{0, 1}));
-  byIndex.indices = {0};
-  EXPECT_THROW(selectFixedVertices(c, byIndex), MeshError);
+  byIndex.lists = {{"--fix-indices", {0}, 0}};
+  EXPECT_EQ(test::errorOf<MeshError>([&] { selectFixedVertices(c, byIndex); }),
+            "--fix-indices: vertex 0 belongs to no tet and was dropped");
+  byIndex.lists = {{"f.bou", {9}, 1}};  // the file's vertex 10, one past the last
+  EXPECT_EQ(test::errorOf<MeshError>([&] { selectFixedVertices(c, byIndex); }),
+            "f.bou: vertex 10 is out of range [1, 9] (numbered from 1)");
 }
 
 TEST(FixedVertices, UnionOfSourcesAndEmptySelectionIsAnError) {
   CheckedMesh c = checkMesh(rawFrom(makeBoxMesh({2, 1, 1}, {2, 1, 1})));
-  std::string dir = test::tempDir("fixed_vertices");
-  std::string bou = dir + "/f.bou";
-  std::ofstream(bou) << "3,\n";  // vertex 3 (1-based) = (2,0,0)
   FixedVertexRequest r;
   r.selectors = {"x<0.5"};
-  r.bouFiles = {bou};
+  r.lists = {{"f.bou", {2}, 1}};  // vertex 3 (1-based) = (2,0,0)
   std::vector<int> fixed = selectFixedVertices(c, r);
   EXPECT_EQ(fixed, (std::vector<int>{0, 2, 3, 6, 9}));
   r.selectors = {"x<-1"};
@@ -138,7 +139,7 @@ TEST(FixedVertices, UnionOfSourcesAndEmptySelectionIsAnError) {
     EXPECT_NE(std::string(e.what()).find("'x<-1' selects no vertex; the mesh spans x [0, 2]"), std::string::npos)
         << e.what();
   }
-  EXPECT_EQ(parseIndexList("1,4-6", "--fix-indices"), (std::vector<int64_t>{1, 4, 5, 6}));
-  EXPECT_THROW(parseIndexList("1,x", "--fix-indices"), MeshError);
-  EXPECT_THROW(parseIndexList("5-2", "--fix-indices"), MeshError);
+  r.selectors.clear();
+  r.lists = {{"empty.bou", {}, 1}};
+  EXPECT_EQ(test::errorOf<MeshError>([&] { selectFixedVertices(c, r); }), "empty.bou: lists no vertex");
 }

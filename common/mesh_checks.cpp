@@ -1,10 +1,10 @@
-#include "formats/mesh/mesh_checks.h"
+#include "common/mesh_checks.h"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
-#include "formats/mesh/mesh_error.h"
+#include "common/mesh_error.h"
 
 namespace quiver {
 
@@ -143,10 +143,6 @@ CheckedMesh checkMesh(RawMesh raw, const MeshCheckOptions& options) {
   out.mesh = std::move(mesh);
   dropUnreferenced(out, raw.source.file);
   return out;
-}
-
-CheckedMesh loadMesh(const std::string& path, const MeshCheckOptions& options, MeshFormat format) {
-  return checkMesh(readMeshFile(path, format), options);
 }
 
 } // namespace quiver

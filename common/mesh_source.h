@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "common/tet_mesh.h"
+
 namespace quiver {
 
 enum class SourcePositionKind { Line, ByteOffset, Record };
@@ -30,6 +32,14 @@ struct MeshSource {
 struct MeshReadReport {
   std::vector<std::string> warnings; // each complete, naming the file
   int64_t skippedCells = 0;          // non-tet cells (triangles, lines, ...) ignored
+};
+
+// A mesh as read, before validation (common/mesh_checks.h): its tets, where each came from, and
+// what the reader noticed.
+struct RawMesh {
+  TetMesh mesh;
+  MeshSource source;
+  MeshReadReport report;
 };
 
 } // namespace quiver

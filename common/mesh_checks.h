@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "formats/mesh/read_mesh.h"
+#include "common/mesh_source.h"
 
 namespace quiver {
 
@@ -25,9 +25,5 @@ struct CheckedMesh {
 // Throws MeshError on the first problem that cannot be fixed (several of one kind are summarised
 // in one message that names the first few).
 CheckedMesh checkMesh(RawMesh raw, const MeshCheckOptions& options = {});
-
-// readMeshFile() then checkMesh().
-CheckedMesh loadMesh(const std::string& path, const MeshCheckOptions& options = {},
-                     MeshFormat format = MeshFormat::Auto);
 
 } // namespace quiver
