@@ -292,7 +292,7 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
     Eigen::MatrixXd axes = Eigen::MatrixXd::Zero(layout.localDofs(), 3);
     for (Eigen::Index i = 0; i < axes.rows(); ++i) axes(i, i % 3) = 1;
     const Eigen::MatrixXd gravity = innerProducts(basis.vectors, multiply(system.mass, axes, layout), ctx.comm());
-    const ModelContents contents = makeModelContents(mesh, perTet, fullU, energy, modes.eigenvalues, gravity, s.model);
+    const ModelContents contents = makeModelContents(mesh, perTet, fullU, energy.coefficients, modes.eigenvalues, gravity, s.model);
     ctx.onRankZero([&] { writeModelFile(s.output + ".qvr", contents); });
   });
   ctx.progress("export: " + s.output + ".qvr [" + fixed3(clock.last()) + " s]");

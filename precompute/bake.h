@@ -10,7 +10,7 @@
 #include "common/fixed_vertices.h"
 #include "common/mesh_checks.h"
 #include "precompute/bake_context.h"
-#include "precompute/stages/export_model.h"
+#include "formats/model_contents.h"
 
 namespace quiver {
 

@@ -1,6 +1,7 @@
 #include "formats/model/qvr_writer.h"
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <stdexcept>
 #include <type_traits>
@@ -39,6 +40,34 @@ Piece piece(SectionType type, const std::vector<T>& values, uint32_t flags = 0) 
 size_t alignUp(size_t at) { return (at + kSectionAlignment - 1) / kSectionAlignment * kSectionAlignment; }
 
 } // namespace
+
+std::vector<double> energyCoefficientsFromGram(const double* gram, int64_t ld, int r) {
+  const auto g = [&](int64_t i, int64_t j) { return gram[j * ld + i]; };  // i <= j
+  const int64_t c2 = monomialCount2(r), c3 = monomialCount3(r), c4 = monomialCount4(r);
+  std::vector<double> out(c2 + c3 + c4, 0.0);
+  double* d2 = out.data();
+  double* d3 = d2 + c2;
+  double* d4 = d3 + c3;
+  std::vector<std::array<int, 2>> pair;
+  for (int j = 0; j < r; ++j)
+    for (int k = j; k < r; ++k) pair.push_back({j, k});
+  const int P = static_cast<int>(pair.size());
+  for (int i = 0; i < r; ++i)
+    for (int j = i; j < r; ++j) d2[monomialIndex2(r, i, j)] += (i == j ? 1.0 : 2.0) * g(i, j);
+  for (int i = 0; i < r; ++i)
+    for (int p = 0; p < P; ++p) {
+      std::array<int, 3> m{i, pair[p][0], pair[p][1]};
+      std::sort(m.begin(), m.end());
+      d3[monomialIndex3(r, m[0], m[1], m[2])] += 2.0 * g(i, r + p);
+    }
+  for (int p = 0; p < P; ++p)
+    for (int s = p; s < P; ++s) {
+      std::array<int, 4> m{pair[p][0], pair[p][1], pair[s][0], pair[s][1]};
+      std::sort(m.begin(), m.end());
+      d4[monomialIndex4(r, m[0], m[1], m[2], m[3])] += (p == s ? 1.0 : 2.0) * g(r + p, r + s);
+    }
+  return out;
+}
 
 std::string formatModel(const ModelContents& c) {
   unsigned char info[kModelInfoSize] = {};

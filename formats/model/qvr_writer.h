@@ -23,6 +23,11 @@ struct ModelContents {
   std::vector<double> rotations;      // 3n x r modal rotations (see ModelView), or empty to leave them out
 };
 
+// The ENERGY_COEFFICIENTS of q^T A2 q + 2 q^T A3 z + z^T A4 z (z the products q_j q_k, j <= k, in
+// order) from the upper triangle of the Gram matrix [A2 A3; A3^T A4] of the reduced energy
+// (common/reduced_energy.h): column-major, leading dimension `ld`, r + r(r+1)/2 square.
+std::vector<double> energyCoefficientsFromGram(const double* gram, int64_t ld, int r);
+
 // The bytes of a version 1.0 .qvr file: the sections in type order, each at the next multiple of
 // 64 bytes after the section table or the previous section, zero padding, checksums. The result is
 // checked with parseModel: contents a reader would refuse (a size that disagrees with info, a

@@ -1,17 +1,9 @@
 #pragma once
-// Stage "polynomials": the reduced St.Venant-Kirchhoff energy E(q) = sum_e V_e W(E_e(Uq)) as an
-// exact quartic polynomial in q (Barbič & James 2005, without cubature: strain is constant on a
-// linear tet). Its gradient is the reduced internal force U^T R(Uq) (cubic) and its Hessian the
-// reduced stiffness U^T K(Uq) U (quadratic).
-//
-// Per tet, with G_j = \sum_a U_{a,j} g_a^T, the Green strain as a 6-vector (xx, yy, zz, yz, xz, xy)
-// is e(q) = L_e q + S_e z(q): column j of L_e is sym(G_j), column (j,k) of S_e is sym(G_j^T G_k)
-// (j < k) or G_j^T G_j / 2 (j = k), and z holds the P = r(r+1)/2 products q_j q_k (j <= k). With
-// D_e = V(\mu W + \tfrac{\lambda}{2} t t^T), W = diag(1,1,1,2,2,2), t = (1,1,1,0,0,0), the energy is
-//   \sum_e e^T D_e e = q^T A_2 q + 2 q^T A_3 z + z^T A_4 z,   [A_2 A_3; A_3^T A_4] = \sum_e B_e^T B_e,
-// with B_e = C_e [L_e S_e] and D_e = C_e^T C_e (6x6 Cholesky). The sum is one symmetric rank-k
-// update (BLAS dsyrk) over the tets stacked in blocks: dense algebra at the machine's peak rather
-// than scalar loops. Each MPI rank sums its own tets; one reduction adds the ranks' sums.
+// Stage "polynomials": the reduced St.Venant-Kirchhoff energy of the basis as an exact quartic
+// in q (the maths: common/reduced_energy.h). Each MPI rank stacks the rows B_e of its own tets in
+// blocks and sums B^T B with one symmetric rank-k update (BLAS dsyrk) per block: dense algebra at
+// the machine's peak rather than scalar loops. One reduction adds the ranks' sums, folded into the
+// .qvr's monomial coefficients.
 #include <cstdint>
 #include <vector>
 

@@ -121,7 +121,7 @@ class QuiverModel(unittest.TestCase):
         self.assertIn("none.qvr: cannot open", p.stderr)
 
 
-class OnTheBakedModel(unittest.TestCase):
+class OnTheTestModel(unittest.TestCase):
     """Shares QuiverModel's baked beam, so the bake runs once per file."""
 
     @classmethod
@@ -132,7 +132,7 @@ class OnTheBakedModel(unittest.TestCase):
         cls.tmp = QuiverModel.tmp
 
 
-class QuiverSim(OnTheBakedModel):
+class QuiverSim(OnTheTestModel):
     """`quiver sim` as a user runs it: the files it promises, readable by an independent reader."""
 
     def sim(self, *args, ok=True):
@@ -178,7 +178,7 @@ class QuiverSim(OnTheBakedModel):
             self.assertIn(message, p.stderr)
 
 
-class QuiverRender(OnTheBakedModel):
+class QuiverRender(OnTheTestModel):
     """`quiver render` without a display: the pictures decode, show the model, and show it moving."""
 
     def render(self, name, *args, ok=True):

@@ -7,8 +7,9 @@
 #include "common/box_mesh.h"
 #include "common/stvk_force_model.h"
 #include "common/mesh_checks.h"
+#include "formats/model_contents.h"
 #include "precompute/stages/assemble.h"
-#include "precompute/stages/export_model.h"
+#include "precompute/stages/polynomials.h"
 #include "precompute/stages/modes.h"
 #include "precompute/stages/partition.h"
 #include "quiver/quiver.h"
@@ -55,7 +56,7 @@ TEST(ModelChain, RuntimeEvaluatesTheFullSpaceProjection) {
   ExportSettings settings;
   settings.basisPrecision = 64;
   const std::string bytes = formatModel(
-      makeModelContents(mesh, perTet, U, energy, modes.eigenvalues, Eigen::MatrixXd::Zero(6, 3), settings));
+      makeModelContents(mesh, perTet, U, energy.coefficients, modes.eigenvalues, Eigen::MatrixXd::Zero(6, 3), settings));
   LoadedModel loaded(bytes);
   ASSERT_NE(loaded.model, nullptr);
   const int r = 6;

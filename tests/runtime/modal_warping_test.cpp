@@ -32,7 +32,7 @@ TEST(ModalWarping, RecoversFiniteRotationsAndIsLinearForSmallOnes) {
 namespace {
 
 // Length of the bar's centre line (the vertices on y = z = 0.05 of the 0.6 x 0.1 x 0.1 bar).
-double centreLineLength(const quiver::test::BakedModel& m, const std::vector<float>& p) {
+double centreLineLength(const quiver::test::TestModel& m, const std::vector<float>& p) {
   std::vector<std::pair<double, int>> line;
   for (int v = 0; v < m.info.vertex_count; ++v)
     if (std::abs(m.mesh.vertices[v].y() - 0.05) < 1e-9 && std::abs(m.mesh.vertices[v].z() - 0.05) < 1e-9)
@@ -67,7 +67,7 @@ std::vector<float> positions(const qv_model* model, const std::vector<double>& q
 // one linear modal displacements stretch the bar (its tip moves straight sideways) while the
 // warped ones keep its length (the rotation carries the tip along an arc).
 TEST(ModalWarping, SmallDeformationsUnchangedLargeBendsKeepTheLength) {
-  quiver::test::BakedModel m;
+  quiver::test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   ASSERT_EQ(m.info.has_modal_rotations, 1);
   const double L = 0.6, tipPerUnit = m.U.col(0).cwiseAbs().maxCoeff();
@@ -93,7 +93,7 @@ TEST(ModalWarping, SmallDeformationsUnchangedLargeBendsKeepTheLength) {
 }
 
 TEST(ModalWarping, StepsWithForcesRotatedIntoTheLocalFrames) {
-  quiver::test::BakedModel m;
+  quiver::test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   qv_instance_config config;
   qv_instance_config_init(&config, m.model);

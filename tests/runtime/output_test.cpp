@@ -7,7 +7,7 @@
 #include "tests/runtime/runtime_fixture.h"
 
 TEST(Output, RestNormalsOfABoxPointOutOfItsFaces) {
-  quiver::test::BakedModel m;
+  quiver::test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   const int n = m.info.vertex_count;
   std::vector<float> rest(3 * n), normals(3 * n);
@@ -31,7 +31,7 @@ TEST(Output, RestNormalsOfABoxPointOutOfItsFaces) {
 }
 
 TEST(Output, InstancesOnThreadsMatchSequentialStepping) {
-  quiver::test::BakedModel m;
+  quiver::test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   const int r = m.info.r, threads = 4;
   qv_instance_config config;

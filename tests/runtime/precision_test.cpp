@@ -6,7 +6,7 @@
 #include "tests/runtime/runtime_fixture.h"
 
 TEST(Precision, Float32CoefficientsStayWithinTheDocumentedError) {
-  quiver::test::BakedModel m;
+  quiver::test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   qv_model_config single;
   qv_model_config_init(&single);

@@ -48,7 +48,7 @@ struct CountingAllocator {
 } // namespace
 
 TEST(RealTime, StepAndOutputAllocateNothing) {
-  quiver::test::BakedModel m;
+  quiver::test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   CountingAllocator counter;
   const qv_allocator allocator{CountingAllocator::allocate, CountingAllocator::release, &counter};
@@ -85,7 +85,7 @@ TEST(RealTime, StepAndOutputAllocateNothing) {
 }
 
 TEST(RealTime, InstanceInCallerMemoryAndModelThroughCallerAllocator) {
-  quiver::test::BakedModel m;
+  quiver::test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   CountingAllocator counter;
   const qv_allocator allocator{CountingAllocator::allocate, CountingAllocator::release, &counter};
@@ -109,7 +109,7 @@ TEST(RealTime, InstanceInCallerMemoryAndModelThroughCallerAllocator) {
 }
 
 TEST(RealTime, BadArgumentsAreRefusedNotCrashed) {
-  quiver::test::BakedModel m;
+  quiver::test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   qv_instance_config config;
   qv_instance_config_init(&config, m.model);

@@ -1,7 +1,7 @@
 #pragma once
-// A model baked by quiver-bake for the runtime tests (fixture runtime_model in tests/CMakeLists.txt),
-// and the full-space reference rebuilt from what the .qvr itself stores: rest shape, tets,
-// material and the float64 basis.
+// The suite's small model (tests/support/small_model.h, fixture test_model in tests/CMakeLists.txt),
+// loaded through the C API, and the full-space reference rebuilt from what the .qvr itself stores:
+// rest shape, tets, material and the float64 basis.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -15,14 +15,14 @@
 
 namespace quiver::test {
 
-struct BakedModel {
+struct TestModel {
   qv_model* model = nullptr;
   qv_model_info info{};
   TetMesh mesh;
   Eigen::MatrixXd U;  // 3n x r
   std::unique_ptr<StVKForceModel> full;
 
-  BakedModel() {
+  TestModel() {
     const std::string path = QUIVER_RUNTIME_MODEL;
     char message[512] = "";
     EXPECT_EQ(qv_model_load_file(path.c_str(), nullptr, nullptr, &model, message, sizeof message), QV_OK) << message;
@@ -33,7 +33,7 @@ struct BakedModel {
     ModelView view;
     std::string error;
     EXPECT_TRUE(parseModel(bytes.data(), bytes.size(), view, error)) << error;
-    EXPECT_NE(view.basis64, nullptr) << "the fixture bakes with --basis-precision 64";
+    EXPECT_NE(view.basis64, nullptr) << "the test model stores a float64 basis";
     EXPECT_NE(view.tets, nullptr);
     for (int v = 0; v < info.vertex_count; ++v)
       mesh.vertices.emplace_back(view.restPositions[3 * v], view.restPositions[3 * v + 1], view.restPositions[3 * v + 2]);
@@ -46,7 +46,7 @@ struct BakedModel {
     m.density = info.density;
     full = std::make_unique<StVKForceModel>(mesh, std::vector<Material>(mesh.tets.size(), m));
   }
-  ~BakedModel() { qv_model_destroy(model); }
+  ~TestModel() { qv_model_destroy(model); }
 
   // The exact projection U^T R(Uq), U^T K(Uq) U.
   void exact(const Eigen::VectorXd& q, Eigen::VectorXd& force, Eigen::MatrixXd& stiffness) const {

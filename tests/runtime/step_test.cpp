@@ -30,7 +30,7 @@ Eigen::VectorXd state(const qv_instance* s, int r) {
 // The reference integrates q'' + C q' + R(q) = f with implicit Newmark (beta 1/4, gamma 1/2) and one
 // Newton step from the previous acceleration, R and K from U^T R(Uq) and U^T K(Uq) U.
 TEST(Step, NewmarkTrajectoryEqualsTheExactProjectionsOver1000Steps) {
-  test::BakedModel m;
+  test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   const int r = m.info.r, tip = m.tipVertex();
   qv_instance_config config;
@@ -68,7 +68,7 @@ TEST(Step, NewmarkTrajectoryEqualsTheExactProjectionsOver1000Steps) {
 }
 
 TEST(Step, UndampedNewmarkKeepsEnergyBoundedOver10000Steps) {
-  test::BakedModel m;
+  test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   const int r = m.info.r;
   qv_instance_config config;
@@ -99,7 +99,7 @@ TEST(Step, UndampedNewmarkKeepsEnergyBoundedOver10000Steps) {
 }
 
 TEST(Step, DampedMotionComesToRestAtTheStaticEquilibrium) {
-  test::BakedModel m;
+  test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   const int r = m.info.r;
   qv_instance_config config;
@@ -125,7 +125,7 @@ TEST(Step, DampedMotionComesToRestAtTheStaticEquilibrium) {
 }
 
 TEST(Step, CentralDifferencesAreStableJustBelowTheReportedStepAndNotAbove) {
-  test::BakedModel m;
+  test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   qv_instance_config config;
   qv_instance_config_init(&config, m.model);
@@ -153,7 +153,7 @@ TEST(Step, CentralDifferencesAreStableJustBelowTheReportedStepAndNotAbove) {
 }
 
 TEST(Step, BlowUpResetsToRestAndSaysSo) {
-  test::BakedModel m;
+  test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   qv_instance_config config;
   qv_instance_config_init(&config, m.model);
@@ -167,7 +167,7 @@ TEST(Step, BlowUpResetsToRestAndSaysSo) {
 }
 
 TEST(Step, DeterministicAndStateRoundTrips) {
-  test::BakedModel m;
+  test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   const int r = m.info.r;
   qv_instance_config config;
@@ -198,7 +198,7 @@ TEST(Step, DeterministicAndStateRoundTrips) {
 }
 
 TEST(Step, DragSpringPullsAVertexToItsTarget) {
-  test::BakedModel m;
+  test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   qv_instance_config config;
   qv_instance_config_init(&config, m.model);
@@ -223,7 +223,7 @@ TEST(Step, DragSpringPullsAVertexToItsTarget) {
 // taken from the full-space FEM; and, unlike StVK, a stretch that grows with the load squared
 // is absent: doubling the load doubles the response exactly.
 TEST(Step, LinearModalDynamicsIsExactlyLinear) {
-  test::BakedModel m;
+  test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   const int r = m.info.r, tip = m.tipVertex();
   qv_instance_config config;

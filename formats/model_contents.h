@@ -1,15 +1,15 @@
 #pragma once
-// Stage "export": the runtime model NAME.qvr (formats/model/QVR.md) from the bake's results:
-// energy polynomial, basis rows, rest positions, surface triangles, the vertex map back to the
-// mesh file, the gravity projection U^T M e_a, eigenvalues, material, default damping, and the
-// modal rotations (1/2 curl of each basis vector at the vertices) for modal warping.
+// The contents of a runtime model (formats/model/QVR.md) from what a bake computed: energy
+// coefficients, basis rows, rest positions, surface triangles, the vertex map back to the mesh
+// file, the gravity projection U^T M e_a, eigenvalues, material, default damping, and the modal
+// rotations (1/2 curl of each basis vector at the vertices) for modal warping. The bake's export
+// stage writes them; tests build small models with them.
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "common/mesh_checks.h"
 #include "formats/model/qvr_writer.h"
-#include "precompute/stages/polynomials.h"
 
 namespace quiver {
 
@@ -19,9 +19,10 @@ struct ExportSettings {
   double timeStep = 1.0 / 60;  // suggested time step, s
 };
 
-// `basis`: full 3n x r in vertex order; `gravity`: r x 3, column a = U^T M e_a.
+// `basis`: full 3n x r in vertex order; `energy`: the ENERGY_COEFFICIENTS of that basis (see
+// energyCoefficientsFromGram); `gravity`: r x 3, column a = U^T M e_a.
 ModelContents makeModelContents(const CheckedMesh& mesh, const std::vector<Material>& perTet,
-                                const Eigen::MatrixXd& basis, const EnergyPolynomial& energy,
+                                const Eigen::MatrixXd& basis, const std::vector<double>& energy,
                                 const std::vector<double>& eigenvalues, const Eigen::MatrixXd& gravity,
                                 const ExportSettings& settings);
 

@@ -1,4 +1,4 @@
-#include "precompute/stages/export_model.h"
+#include "formats/model_contents.h"
 
 #include <cmath>
 
@@ -8,7 +8,7 @@
 namespace quiver {
 
 ModelContents makeModelContents(const CheckedMesh& mesh, const std::vector<Material>& perTet,
-                                const Eigen::MatrixXd& basis, const EnergyPolynomial& energy,
+                                const Eigen::MatrixXd& basis, const std::vector<double>& energy,
                                 const std::vector<double>& eigenvalues, const Eigen::MatrixXd& gravity,
                                 const ExportSettings& settings) {
   const TetMesh& m = mesh.mesh;
@@ -54,7 +54,7 @@ ModelContents makeModelContents(const CheckedMesh& mesh, const std::vector<Mater
     info.bboxMax[a] = box[1][a];
   }
 
-  c.energy = energy.coefficients;
+  c.energy = energy;
   c.basis.resize(basis.size());
   for (Eigen::Index i = 0; i < basis.rows(); ++i)
     for (int j = 0; j < r; ++j) c.basis[i * r + j] = basis(i, j);

@@ -1,0 +1,27 @@
+#pragma once
+// A small model made the way the bake makes one, from common/ and formats/ alone (dense Eigen
+// instead of PETSc/SLEPc/MPI): a cantilever beam clamped at x = 0, its lowest modes and their
+// modal derivatives, mass-PCA into U, and the exact reduced StVK energy of U. The runtime's and
+// the tools' tests load it, so they build and run without the bake.
+#include <array>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "common/material.h"
+#include "formats/model/qvr_writer.h"
+
+namespace quiver::test {
+
+struct SmallModelSpec {
+  Eigen::Vector3d size{0.6, 0.1, 0.1};  // m
+  std::array<int, 3> cells{12, 2, 2};
+  double youngsModulus = 1e6, poissonRatio = 0.4, density = 1000;
+  int modes = 6;         // k lowest modes and their k(k+1)/2 derivatives
+  int rank = 10;         // r
+  int basisPrecision = 64;
+};
+
+ModelContents smallBeamModel(const SmallModelSpec& spec = {});
+
+} // namespace quiver::test
