@@ -56,6 +56,9 @@ class QuiverModel(unittest.TestCase):
         vega = 8 * r * (r + r * (r + 1) // 2 + r * (r + 1) * (r + 2) // 6)  # Vega's .cub coefficient layout
         self.assertLess(j["sections"]["ENERGY_COEFFICIENTS"], vega)
         self.assertEqual(j["sections"]["BASIS"], 4 * 3 * j["vertices"] * r)  # float32 by default
+        # Every section by its name in QVR.md (the reader's own table), none as a bare type number.
+        self.assertEqual(j["sections"]["MODAL_ROTATIONS"], 8 * 3 * j["vertices"] * r)
+        self.assertEqual([name for name in j["sections"] if "type" in name], [])
         np.testing.assert_allclose(j["frequencies_hz"], np.sqrt(self.eigenvalues) / (2 * np.pi), rtol=1e-12)
         # The modes as the reduced model has them (its own K~(0) in span U) are Rayleigh-Ritz approximations of
         # the ones SLEPc baked: never below them; the first, which the basis weighs most, close.
@@ -121,7 +124,7 @@ class QuiverModel(unittest.TestCase):
         self.assertIn("none.qvr: cannot open", p.stderr)
 
 
-class OnTheTestModel(unittest.TestCase):
+class OnTheBakedModel(unittest.TestCase):
     """Shares QuiverModel's baked beam, so the bake runs once per file."""
 
     @classmethod
@@ -132,7 +135,7 @@ class OnTheTestModel(unittest.TestCase):
         cls.tmp = QuiverModel.tmp
 
 
-class QuiverSim(OnTheTestModel):
+class QuiverSim(OnTheBakedModel):
     """`quiver sim` as a user runs it: the files it promises, readable by an independent reader."""
 
     def sim(self, *args, ok=True):
@@ -178,7 +181,7 @@ class QuiverSim(OnTheTestModel):
             self.assertIn(message, p.stderr)
 
 
-class QuiverRender(OnTheTestModel):
+class QuiverRender(OnTheBakedModel):
     """`quiver render` without a display: the pictures decode, show the model, and show it moving."""
 
     def render(self, name, *args, ok=True):

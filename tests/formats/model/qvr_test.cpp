@@ -4,11 +4,14 @@
 #include <cstdint>
 #include <fstream>
 #include <iterator>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include <Eigen/Core>
 
 #include "formats/model/fnv1a.h"
 #include "formats/model/qvr.h"
@@ -230,6 +233,42 @@ TEST(Qvr, ModalRotationsRoundTripAsAnOptionalSection) {
   EXPECT_EQ(copyModel(view).rotations.size(), 3 * size_t{c.info.vertexCount} * c.info.r);
 }
 
+TEST(Qvr, EverySectionTypeHasOneNameAndUnknownOnesSayTheirNumber) {
+  EXPECT_EQ(qvr::sectionName(qvr::kModelInfo), "MODEL_INFO");
+  EXPECT_EQ(qvr::sectionName(qvr::kModalRotations), "MODAL_ROTATIONS");
+  for (uint32_t t = 1; t <= qvr::kLastKnownType; ++t) EXPECT_EQ(qvr::sectionName(t).find("type"), std::string::npos) << t;
+  EXPECT_EQ(qvr::sectionName(qvr::kLastKnownType + 1), "section type " + std::to_string(qvr::kLastKnownType + 1));
+  EXPECT_EQ(qvr::sectionName(0), "section type 0");
+}
+
+// The energy w^T G w of w = [q; q_j q_k (j <= k)] equals the folded monomials summed term by term.
+TEST(Qvr, TheGramMatrixFoldsIntoTheEnergyMonomials) {
+  const int r = 3, P = r * (r + 1) / 2, N = r + P;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Eigen::MatrixXd B(7, N);
+  for (int i = 0; i < B.size(); ++i) B.data()[i] = u(rng);
+  const Eigen::MatrixXd G = B.transpose() * B;
+  const std::vector<double> c = energyCoefficientsFromGram(G.data(), N, r);
+  ASSERT_EQ(c.size(), static_cast<size_t>(monomialCount2(r) + monomialCount3(r) + monomialCount4(r)));
+  for (int trial = 0; trial < 5; ++trial) {
+    Eigen::VectorXd q(r), w(N);
+    for (int i = 0; i < r; ++i) w[i] = q[i] = u(rng);
+    for (int j = 0, p = r; j < r; ++j)
+      for (int k = j; k < r; ++k) w[p++] = q[j] * q[k];
+    double sum = 0;
+    for (int i = 0; i < r; ++i)
+      for (int j = i; j < r; ++j) {
+        sum += c[monomialIndex2(r, i, j)] * q[i] * q[j];
+        for (int k = j; k < r; ++k) {
+          sum += c[monomialCount2(r) + monomialIndex3(r, i, j, k)] * q[i] * q[j] * q[k];
+          for (int l = k; l < r; ++l)
+            sum += c[monomialCount2(r) + monomialCount3(r) + monomialIndex4(r, i, j, k, l)] * q[i] * q[j] * q[k] * q[l];
+        }
+      }
+    EXPECT_NEAR(sum, w.dot(G * w), 1e-12 * std::abs(w.dot(G * w)) + 1e-14);
+  }
+}
+
 } // namespace
 } // namespace quiver
-
