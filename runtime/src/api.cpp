@@ -46,6 +46,12 @@ bool validVertices(const qv_instance* s, const int* vertices, int count) {
   return true;
 }
 
+// A field of row `index` of a name table, or null out of range.
+template <class Entry, size_t N>
+const char* entry(const Entry (&table)[N], int index, const char* Entry::*field) {
+  return index >= 0 && index < static_cast<int>(N) ? table[index].*field : nullptr;
+}
+
 template <class Table, class Enum>
 qv_result fromName(const Table& table, const char* name, Enum* out) {
   if (!name || !out) return QV_ERROR_INVALID_ARGUMENT;
@@ -81,21 +87,13 @@ const char* qv_result_string(qv_result result) {
   return "unknown result";
 }
 
-const char* qv_integrator_name(qv_integrator i) {
-  return i >= 0 && i < QV_INTEGRATOR_COUNT ? kIntegrators[i].name : nullptr;
-}
-const char* qv_integrator_description(qv_integrator i) {
-  return i >= 0 && i < QV_INTEGRATOR_COUNT ? kIntegrators[i].description : nullptr;
-}
+const char* qv_integrator_name(qv_integrator i) { return entry(kIntegrators, i, &IntegratorEntry::name); }
+const char* qv_integrator_description(qv_integrator i) { return entry(kIntegrators, i, &IntegratorEntry::description); }
 qv_result qv_integrator_from_name(const char* name, qv_integrator* integrator) {
   return fromName(kIntegrators, name, integrator);
 }
-const char* qv_elasticity_name(qv_elasticity e) {
-  return e >= 0 && e < QV_ELASTICITY_COUNT ? kElasticities[e].name : nullptr;
-}
-const char* qv_elasticity_description(qv_elasticity e) {
-  return e >= 0 && e < QV_ELASTICITY_COUNT ? kElasticities[e].description : nullptr;
-}
+const char* qv_elasticity_name(qv_elasticity e) { return entry(kElasticities, e, &ElasticityEntry::name); }
+const char* qv_elasticity_description(qv_elasticity e) { return entry(kElasticities, e, &ElasticityEntry::description); }
 qv_result qv_elasticity_from_name(const char* name, qv_elasticity* elasticity) {
   return fromName(kElasticities, name, elasticity);
 }
