@@ -56,6 +56,53 @@ std::vector<double> parseQ(const std::string& text, int r) {
   return q;
 }
 
+// `quiver info`: counts, section sizes, baked and reduced frequencies, material, damping, box.
+ordered_json describeModel(const quiver::app::RuntimeModel& model) {
+  const qv_model_info& mi = model.info();
+  ordered_json out;
+  out["r"] = mi.r;
+  out["vertices"] = mi.vertex_count;
+  out["tets"] = mi.tet_count;
+  out["surface_triangles"] = mi.triangle_count;
+  out["file_vertices"] = mi.file_vertex_count;
+  out["basis_precision"] = mi.basis_precision;
+  out["sections"] = sectionSizes(model.path());
+  std::vector<double> hz;
+  for (int i = 0; i < mi.eigenvalue_count; ++i)
+    hz.push_back(std::sqrt(std::max(qv_model_eigenvalues(model.get())[i], 0.0)) / (2 * M_PI));
+  out["frequencies_hz"] = hz;
+  // The same modes as the reduced model has them (K~(0) in span U): how well the basis holds the baked modes.
+  hz.clear();
+  for (double lambda : quiver::app::reducedModes(model.get()).eigenvalues)
+    hz.push_back(std::sqrt(std::max(lambda, 0.0)) / (2 * M_PI));
+  out["reduced_frequencies_hz"] = hz;
+  out["material"] = {{"youngs_modulus", mi.youngs_modulus}, {"poisson_ratio", mi.poisson_ratio},
+                     {"density", mi.density}, {"uniform", mi.material_is_uniform != 0}};
+  out["total_mass"] = mi.total_mass;
+  out["damping"] = {{"rayleigh_alpha", mi.rayleigh_alpha}, {"rayleigh_beta", mi.rayleigh_beta}};
+  out["time_step"] = mi.time_step;
+  out["bbox"] = {{"min", {mi.bbox_min[0], mi.bbox_min[1], mi.bbox_min[2]}},
+                 {"max", {mi.bbox_max[0], mi.bbox_max[1], mi.bbox_max[2]}}};
+  return out;
+}
+
+// `quiver eval`: energy, force and stiffness at q.
+ordered_json evaluateModel(const quiver::app::RuntimeModel& model, const std::string& qText) {
+  const int r = model.info().r;
+  const std::vector<double> q = parseQ(qText, r);
+  std::vector<double> scratch(qv_model_scratch_size(model.get()) / sizeof(double) + 1), force(r),
+      stiffness(static_cast<size_t>(r) * r);
+  double energy = 0;
+  qv_model_evaluate(model.get(), q.data(), &energy, force.data(), stiffness.data(), scratch.data());
+  ordered_json out;
+  out["energy"] = energy;
+  out["force"] = force;
+  std::vector<std::vector<double>> rows;
+  for (int i = 0; i < r; ++i) rows.emplace_back(stiffness.begin() + i * r, stiffness.begin() + (i + 1) * r);
+  out["stiffness"] = rows;
+  return out;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -107,44 +154,7 @@ int main(int argc, char** argv) {
     if (*render) return quiver::app::renderModel(path, renderOptions);
     if (*sim) return quiver::app::simulateModel(path, simOptions);
     const quiver::app::RuntimeModel model(path);
-    const qv_model_info& mi = model.info();
-    ordered_json out;
-    if (*info) {
-      out["r"] = mi.r;
-      out["vertices"] = mi.vertex_count;
-      out["tets"] = mi.tet_count;
-      out["surface_triangles"] = mi.triangle_count;
-      out["file_vertices"] = mi.file_vertex_count;
-      out["basis_precision"] = mi.basis_precision;
-      out["sections"] = sectionSizes(path);
-      std::vector<double> hz;
-      for (int i = 0; i < mi.eigenvalue_count; ++i)
-        hz.push_back(std::sqrt(std::max(qv_model_eigenvalues(model.get())[i], 0.0)) / (2 * M_PI));
-      out["frequencies_hz"] = hz;
-      // The same modes as the reduced model has them (K~(0) in span U): how well the basis holds the baked modes.
-      hz.clear();
-      for (double lambda : quiver::app::reducedModes(model.get()).eigenvalues)
-        hz.push_back(std::sqrt(std::max(lambda, 0.0)) / (2 * M_PI));
-      out["reduced_frequencies_hz"] = hz;
-      out["material"] = {{"youngs_modulus", mi.youngs_modulus}, {"poisson_ratio", mi.poisson_ratio},
-                         {"density", mi.density}, {"uniform", mi.material_is_uniform != 0}};
-      out["total_mass"] = mi.total_mass;
-      out["damping"] = {{"rayleigh_alpha", mi.rayleigh_alpha}, {"rayleigh_beta", mi.rayleigh_beta}};
-      out["time_step"] = mi.time_step;
-      out["bbox"] = {{"min", {mi.bbox_min[0], mi.bbox_min[1], mi.bbox_min[2]}},
-                     {"max", {mi.bbox_max[0], mi.bbox_max[1], mi.bbox_max[2]}}};
-    } else {
-      const std::vector<double> q = parseQ(qText, mi.r);
-      std::vector<double> scratch(qv_model_scratch_size(model.get()) / sizeof(double) + 1), force(mi.r),
-          stiffness(static_cast<size_t>(mi.r) * mi.r);
-      double energy = 0;
-      qv_model_evaluate(model.get(), q.data(), &energy, force.data(), stiffness.data(), scratch.data());
-      out["energy"] = energy;
-      out["force"] = force;
-      std::vector<std::vector<double>> rows;
-      for (int i = 0; i < mi.r; ++i) rows.emplace_back(stiffness.begin() + i * mi.r, stiffness.begin() + (i + 1) * mi.r);
-      out["stiffness"] = rows;
-    }
+    const ordered_json out = *info ? describeModel(model) : evaluateModel(model, qText);
     // Full precision: every double printed reads back exactly (nlohmann prints shortest round-trip form).
     std::cout << out.dump(1) << "\n";
     return 0;
