@@ -97,6 +97,9 @@ const char* qv_elasticity_description(qv_elasticity e) { return entry(kElasticit
 qv_result qv_elasticity_from_name(const char* name, qv_elasticity* elasticity) {
   return fromName(kElasticities, name, elasticity);
 }
+const char* qv_solver_name(qv_solver v) { return entry(kSolvers, v, &SolverEntry::name); }
+const char* qv_solver_description(qv_solver v) { return entry(kSolvers, v, &SolverEntry::description); }
+qv_result qv_solver_from_name(const char* name, qv_solver* solver) { return fromName(kSolvers, name, solver); }
 
 // ---- Models ----
 
@@ -249,6 +252,10 @@ void qv_instance_destroy(qv_instance* s) {
 
 qv_step_status qv_instance_step(qv_instance* s) { return s->step(); }
 
+void qv_instance_last_step(const qv_instance* s, qv_step_report* report) {
+  if (s && report) *report = s->lastStep;
+}
+
 qv_result qv_instance_add_vertex_force(qv_instance* s, int vertex, const double force[3]) {
   if (!s || !force || !validVertex(s, vertex)) return QV_ERROR_INVALID_ARGUMENT;
   s->loads.addVertexForce(*s->model, s->config.elasticity, s->q, vertex, force);
@@ -287,6 +294,18 @@ void qv_instance_get_state(const qv_instance* s, double* q, double* v, double* a
 
 void qv_instance_set_state(qv_instance* s, const double* q, const double* v, const double* a) {
   if (s) s->setState(q, v, a);
+}
+
+size_t qv_instance_snapshot_size(const qv_instance* s) { return s ? s->snapshotSize() : 0; }
+
+void qv_instance_save_snapshot(const qv_instance* s, void* snapshot) {
+  if (s && snapshot) s->saveSnapshot(static_cast<double*>(snapshot));
+}
+
+qv_result qv_instance_restore_snapshot(qv_instance* s, const void* snapshot, size_t size) {
+  if (!s || !snapshot || size != s->snapshotSize() || reinterpret_cast<uintptr_t>(snapshot) % alignof(double) != 0)
+    return QV_ERROR_INVALID_ARGUMENT;
+  return s->restoreSnapshot(static_cast<const double*>(snapshot)) ? QV_OK : QV_ERROR_INVALID_ARGUMENT;
 }
 
 void qv_instance_reset(qv_instance* s) {

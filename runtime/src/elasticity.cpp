@@ -24,6 +24,7 @@ void evaluateElasticity(const qv_model& m, qv_elasticity elasticity, const doubl
       for (int j = 0; j < r; ++j) s += m.restStiffness[i * r + j] * q[j];
       force[i] = s;
     }
+  if (energy) *energy = elasticEnergy(m, elasticity, q, scratch);
 }
 
 double elasticEnergy(const qv_model& m, qv_elasticity elasticity, const double* q, double* scratch) {

@@ -14,8 +14,8 @@ struct ElasticityEntry {
 // Indexed by qv_elasticity: the one table of names.
 extern const ElasticityEntry kElasticities[QV_ELASTICITY_COUNT];
 
-// Elastic energy E(q), force R(q) and stiffness K(q) (any may be null; linear models give no
-// energy here: see elasticEnergy). `scratch`: ReducedPolynomial::scratchSize(r) doubles.
+// Elastic energy E(q), force R(q) and stiffness K(q) (any may be null). `scratch`:
+// ReducedPolynomial::scratchSize(r) doubles.
 void evaluateElasticity(const qv_model& model, qv_elasticity elasticity, const double* q, double* energy,
                         double* force, double* stiffness, double* scratch);
 

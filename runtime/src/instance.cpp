@@ -12,7 +12,9 @@
 namespace quiver::rt {
 
 bool validConfig(const qv_model* model, const qv_instance_config* c) {
-  return model && c && c->integrator >= 0 && c->integrator < QV_INTEGRATOR_COUNT && c->elasticity >= 0 &&
+  return model && c && c->integrator >= 0 && c->integrator < QV_INTEGRATOR_COUNT && c->solver >= 0 &&
+         c->solver < QV_SOLVER_COUNT && c->newton_tolerance > 0 && std::isfinite(c->newton_tolerance) &&
+         c->elasticity >= 0 &&
          c->elasticity < QV_ELASTICITY_COUNT && (!kElasticities[c->elasticity].needsRotations || model->rotations) &&
          c->time_step > 0 && std::isfinite(c->time_step) && c->newton_iterations >= 1 && c->rayleigh_alpha >= 0 &&
          c->rayleigh_beta >= 0 && c->max_constraints >= 0 && c->max_constraints <= 64 && c->max_displacement > 0;
@@ -21,7 +23,9 @@ bool validConfig(const qv_model* model, const qv_instance_config* c) {
 void defaultConfig(qv_instance_config& config, const qv_model* model) {
   config.integrator = QV_INTEGRATOR_IMPLICIT_NEWMARK;
   config.time_step = model ? model->info.time_step : 1.0 / 60.0;
-  config.newton_iterations = 1;
+  config.solver = QV_SOLVER_MINIMIZE;
+  config.newton_iterations = 8;
+  config.newton_tolerance = 1e-6;
   config.rayleigh_alpha = model ? model->info.rayleigh_alpha : 0.0;
   config.rayleigh_beta = model ? model->info.rayleigh_beta : 0.0;
   config.max_constraints = 4;
@@ -81,6 +85,10 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
   work.system = c.take<double>(rr);
   work.correction = c.take<double>(r);
   work.retryRhs = c.take<double>(r);
+  work.predictor = c.take<double>(r);
+  work.predictorVelocity = c.take<double>(r);
+  work.gradient = c.take<double>(r);
+  work.trial = c.take<double>(r);
   work.pivot = c.take<int>(r);
   work.polynomialScratch = c.take<double>(quiver::rt::ReducedPolynomial::scratchSize(r));
 }
@@ -89,15 +97,21 @@ void qv_instance::rest() {
   std::memset(q, 0, sizeof(double) * r);
   std::memset(v, 0, sizeof(double) * r);
   std::memset(a, 0, sizeof(double) * r);
+  elasticEnergyAtState = 0;
+  energySlack = 0;
 }
 
 bool qv_instance::healthy() const {
+  // The minimising solver cannot run away on finite input, so only non-finite states reset it.
+  const bool bounded = config.solver == QV_SOLVER_MINIMIZE && config.integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES;
   for (int i = 0; i < r; ++i)
-    if (!(std::fabs(q[i]) <= maxQ) || !std::isfinite(v[i]) || !std::isfinite(a[i])) return false;
+    if (!(bounded ? std::isfinite(q[i]) : std::fabs(q[i]) <= maxQ) || !std::isfinite(v[i]) || !std::isfinite(a[i]))
+      return false;
   return true;
 }
 
 qv_step_status qv_instance::step() {
+  lastStep = qv_step_report{};
   const qv_step_status status = quiver::rt::kIntegrators[config.integrator].step(*this);
   loads.endStep();
   if (status == QV_STEP_RESET || !healthy()) {
@@ -118,6 +132,27 @@ void qv_instance::setState(const double* newQ, const double* newV, const double*
     quiver::rt::evaluateForces(*this, q);
     for (int i = 0; i < r; ++i) a[i] = loads.gravityForce[i] - work.force[i] - quiver::rt::dampingForce(*this, i, v);
   }
+  if (newQ) elasticEnergyAtState = quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
+  energySlack = 0;
+}
+
+void qv_instance::saveSnapshot(double* out) const {
+  out[0] = r;
+  std::memcpy(out + 1, q, sizeof(double) * r);
+  std::memcpy(out + 1 + r, v, sizeof(double) * r);
+  std::memcpy(out + 1 + 2 * r, a, sizeof(double) * r);
+  out[1 + 3 * r] = elasticEnergyAtState;
+  out[2 + 3 * r] = energySlack;
+}
+
+bool qv_instance::restoreSnapshot(const double* in) {
+  if (in[0] != r) return false;
+  std::memcpy(q, in + 1, sizeof(double) * r);
+  std::memcpy(v, in + 1 + r, sizeof(double) * r);
+  std::memcpy(a, in + 1 + 2 * r, sizeof(double) * r);
+  elasticEnergyAtState = in[1 + 3 * r];
+  energySlack = in[2 + 3 * r];
+  return true;
 }
 
 void qv_instance::energies(double* kinetic, double* elastic) const {

@@ -22,6 +22,10 @@ struct StepBuffers {
   double* system = nullptr;       // the Newton matrix, factorised in place
   double* correction = nullptr;   // the Newton right-hand side in, the correction out
   double* retryRhs = nullptr;     // the right-hand side kept for the LU retry
+  double* predictor = nullptr;    // the minimising solver's qt and v0 (incremental_potential.h)
+  double* predictorVelocity = nullptr;
+  double* gradient = nullptr;     // its gradient at the current iterate
+  double* trial = nullptr;        // its line search's trial point
   int* pivot = nullptr;           // LU's row exchanges
   double* polynomialScratch = nullptr;
 };
@@ -41,8 +45,11 @@ struct qv_instance {
   bool ownsMemory;
   qv_instance_config config;
   int r;
-  double maxQ;  // |q|_inf beyond which the state counts as blown up
+  double maxQ;  // |q|_inf beyond which the state counts as blown up (Newton solver, central differences)
   double *q, *v, *a;
+  double elasticEnergyAtState;  // E(q), kept by whatever changes q (the minimising solver's energy budget)
+  double energySlack;           // energy the discretisation lost that a later step may win back
+  qv_step_report lastStep;
   quiver::rt::Loads loads;
   quiver::rt::EndOfStep end;
   quiver::rt::StepBuffers work;
@@ -53,5 +60,9 @@ struct qv_instance {
   // One step of the configured integrator; per-step loads are spent; a blown-up state resets.
   qv_step_status step();
   void setState(const double* q, const double* v, const double* a);
+  // The snapshot: r, then q, v, a, E(q) and the energy slack, as doubles.
+  size_t snapshotSize() const { return sizeof(double) * (3 * static_cast<size_t>(r) + 3); }
+  void saveSnapshot(double* out) const;
+  bool restoreSnapshot(const double* in);
   void energies(double* kinetic, double* elastic) const;
 };

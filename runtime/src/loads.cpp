@@ -26,12 +26,15 @@ void Loads::clear() {
   combineConstraints();
 }
 
-const double* Loads::addStateForces(const double* q, double* force) const {
+const double* Loads::addStateForces(const double* q, double* force, double* energy) const {
+  double potential = 0;  // q^T Kc q / 2 - bc^T q
   for (int i = 0; i < r; ++i) {
     double s = -constraintB[i];
     for (int j = 0; j < r; ++j) s += constraintK[i * r + j] * q[j];
     force[i] += s;
+    potential += 0.5 * q[i] * (s - constraintB[i]);
   }
+  if (energy) *energy = potential;
   return constraintK;
 }
 

@@ -34,7 +34,9 @@ struct Loads {
   void clear();  // nothing acting
 
   double external(int i) const { return stepForce[i] + gravityForce[i]; }
-  const double* addStateForces(const double* q, double* force) const;
+  // `energy`, when not null, receives the state forces' potential at q (the minimising solver needs
+  // it: every state force it steps with must have one, up to a constant).
+  const double* addStateForces(const double* q, double* force, double* energy = nullptr) const;
   void endStep();  // the per-step forces are spent
 
   // `q`: the current state, to rotate the force into the vertex's frame under modal warping.

@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
 
   qv_instance_config config;
   qv_instance_config_init(&config, model);
-  CHECK(config.integrator == QV_INTEGRATOR_IMPLICIT_NEWMARK && config.newton_iterations == 1);
+  CHECK(config.integrator == QV_INTEGRATOR_IMPLICIT_NEWMARK && config.solver == QV_SOLVER_MINIMIZE && config.newton_iterations == 8);
   qv_instance* instance = NULL;
   CHECK(qv_instance_create(model, &config, NULL, &instance) == QV_OK);
   const double gravity[3] = {0, 0, -9.81};

@@ -135,24 +135,48 @@ typedef enum qv_elasticity {
   QV_ELASTICITY_COUNT
 } qv_elasticity;
 
+/* How an implicit step (Newmark, backward Euler) solves for the end of the step. */
+typedef enum qv_solver {
+  QV_SOLVER_MINIMIZE = 0, /* default. The step is the minimum of its incremental potential (inertia + elastic
+                             energy + the loads' potentials + a damping potential): Newton on a Hessian shifted to
+                             positive definite where compression makes it indefinite, backtracking on the potential,
+                             until the gradient is below newton_tolerance or after newton_iterations; the total
+                             energy never grows within a step (what the integrator would add is taken out of the
+                             velocity). No bounded load can make it run away: it resets only on non-finite input.
+                             Rayleigh damping uses the rest stiffness, C = alpha I + beta K(0). Costs about twice a
+                             Newton step when one iteration converges (bench/README.md). */
+  QV_SOLVER_NEWTON = 1,   /* Barbic & James 2005: exactly newton_iterations Newton iterations on the equations of
+                             motion, no line search, C = alpha I + beta K(q): the fastest. Safe for loads that keep
+                             the strains moderate at the model's time step; stiff springs, large twists, long time
+                             steps or sudden releases can diverge (then it resets to rest: QV_STEP_RESET). */
+  QV_SOLVER_COUNT
+} qv_solver;
+
 /* Each choice has one short name, for options and files ("newmark", "euler", "central"; "stvk", "linear",
-   "warping"), and a description for menus; both NULL out of range. *_from_name sets *value and returns QV_OK, or
-   returns QV_ERROR_INVALID_ARGUMENT for a name it does not know. */
+   "warping"; "minimize", "newton"), and a description for menus; both NULL out of range. *_from_name sets *value
+   and returns QV_OK, or returns QV_ERROR_INVALID_ARGUMENT for a name it does not know. */
 QV_API const char* qv_integrator_name(qv_integrator integrator);
 QV_API const char* qv_integrator_description(qv_integrator integrator);
 QV_API qv_result qv_integrator_from_name(const char* name, qv_integrator* integrator);
 QV_API const char* qv_elasticity_name(qv_elasticity elasticity);
 QV_API const char* qv_elasticity_description(qv_elasticity elasticity);
 QV_API qv_result qv_elasticity_from_name(const char* name, qv_elasticity* elasticity);
+QV_API const char* qv_solver_name(qv_solver solver);
+QV_API const char* qv_solver_description(qv_solver solver);
+QV_API qv_result qv_solver_from_name(const char* name, qv_solver* solver);
 
 typedef struct qv_instance_config {
   qv_integrator integrator;  /* default QV_INTEGRATOR_IMPLICIT_NEWMARK */
   double time_step;          /* s, > 0; default: the model's suggested step */
-  int newton_iterations;     /* implicit integrators, >= 1; default 1 (as Barbic & James) */
+  qv_solver solver;          /* implicit integrators; default QV_SOLVER_MINIMIZE */
+  int newton_iterations;     /* >= 1: the most Newton iterations (QV_SOLVER_MINIMIZE, default 8), or exactly this many
+                                (QV_SOLVER_NEWTON; Barbic & James use 1) */
+  double newton_tolerance;   /* QV_SOLVER_MINIMIZE stops once |gradient| <= this x the step's force scale; default 1e-6 */
   double rayleigh_alpha;     /* 1/s, >= 0; default: the model's */
   double rayleigh_beta;      /* s, >= 0; default: the model's */
   int max_constraints;       /* penalty constraint slots (drag springs, pinned groups), 0..64; default 4 */
-  double max_displacement;   /* m; a step that moves a vertex farther resets the instance; default 100 x the model's diagonal */
+  double max_displacement;   /* m; QV_SOLVER_NEWTON and central differences: a step that moves a vertex farther resets
+                                the instance; default 100 x the model's diagonal */
   qv_elasticity elasticity;  /* default QV_ELASTICITY_STVK */
 } qv_instance_config;
 
@@ -173,13 +197,26 @@ QV_API void qv_instance_destroy(qv_instance* instance);
 
 typedef enum qv_step_status {
   QV_STEP_OK = 0,
-  QV_STEP_INDEFINITE = 1, /* the system matrix was indefinite (large compression); solved by pivoting LU instead */
-  QV_STEP_RESET = 2       /* the state became non-finite or exceeded max_displacement, or the solve failed:
-                             the instance was reset to rest */
+  QV_STEP_INDEFINITE = 1, /* the system matrix was indefinite (large compression): shifted to positive definite
+                             (QV_SOLVER_MINIMIZE) or solved by pivoting LU (QV_SOLVER_NEWTON) */
+  QV_STEP_RESET = 2       /* the state became non-finite (any solver), exceeded max_displacement or the solve failed
+                             (QV_SOLVER_NEWTON, central differences): the instance was reset to rest */
 } qv_step_status;
 
 /* Advances one time step under the loads set so far; per-step loads are then cleared. */
 QV_API qv_step_status qv_instance_step(qv_instance* instance);
+
+/* What the last step did (all zero before the first). */
+typedef struct qv_step_report {
+  int newton_iterations;   /* Newton iterations taken (0 for central differences) */
+  int line_search_cuts;    /* QV_SOLVER_MINIMIZE: step halvings in all */
+  int converged;           /* QV_SOLVER_MINIMIZE: 1 when the gradient met newton_tolerance */
+  double gradient;         /* QV_SOLVER_MINIMIZE: |gradient| / force scale at the end */
+  int held_back;           /* QV_SOLVER_MINIMIZE: 1 when the end position alone held more energy than the step began
+                              with (the iteration cap came first), so it was drawn back toward the start and stopped */
+  double energy_removed;   /* QV_SOLVER_MINIMIZE: kinetic energy (J) the step took out so as not to add energy */
+} qv_step_report;
+QV_API void qv_instance_last_step(const qv_instance* instance, qv_step_report* report);
 
 /* Loads. Per-step (cleared by each step): a force on one vertex (N), a reduced force (r values).
    Persistent: gravity (m/s^2), and penalty constraints pulling vertices toward targets with a
@@ -194,10 +231,18 @@ QV_API void qv_instance_clear_constraint(qv_instance* instance, int slot);
 
 /* State (r values each; any pointer may be NULL: that part is left as it is, except that a NULL
    acceleration with a new q or velocity is replaced by the one the equations of motion give there
-   under the persistent loads), reset to rest, and energies (J). */
+   under the persistent loads; a new state starts a new energy budget), reset to rest, and energies (J). */
 QV_API void qv_instance_get_state(const qv_instance* instance, double* q, double* velocity, double* acceleration);
 QV_API void qv_instance_set_state(qv_instance* instance, const double* q, const double* velocity,
                                   const double* acceleration);
+
+/* Everything that evolves (q, velocity, acceleration and the solver's energy budget) as an opaque
+   block of qv_instance_snapshot_size() bytes, for rewinding, replays and save games: restoring a
+   snapshot and repeating the same calls repeats the same bits. Restoring checks the size and that
+   the snapshot came from a model of the same r (QV_ERROR_INVALID_ARGUMENT otherwise). */
+QV_API size_t qv_instance_snapshot_size(const qv_instance* instance);
+QV_API void qv_instance_save_snapshot(const qv_instance* instance, void* snapshot);
+QV_API qv_result qv_instance_restore_snapshot(qv_instance* instance, const void* snapshot, size_t size);
 QV_API void qv_instance_reset(qv_instance* instance);
 QV_API void qv_instance_energies(const qv_instance* instance, double* kinetic, double* elastic);
 

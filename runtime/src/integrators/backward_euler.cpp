@@ -1,19 +1,43 @@
-// Backward Euler: Newton on the end-of-step velocity, starting from the current one. First order
-// and numerically damped.
+// Backward Euler: first order and numerically damped. The minimising solver
+// (incremental_potential.h) by default; QV_SOLVER_NEWTON: Newton on the end-of-step velocity,
+// starting from the current one.
 #include <cstring>
 
 #include "../dynamics.h"
+#include "incremental_potential.h"
 #include "integrator.h"
 
 namespace quiver::rt {
 
+namespace {
+
+qv_step_status minimizing(qv_instance& s) {
+  const double h = s.config.time_step;
+  const int r = s.r;
+  double *q = s.q, *v = s.v, *a = s.a;
+  for (int i = 0; i < r; ++i) {
+    s.work.predictor[i] = s.end.q[i] = q[i] + h * v[i];  // qt, and the guess
+    s.work.predictorVelocity[i] = v[i];
+  }
+  const qv_step_status status = minimizeStep(s, StepPredictor{1 / (h * h), 1 / h, h});
+  for (int i = 0; i < r; ++i) {
+    a[i] = (s.end.v[i] - v[i]) / h;
+    v[i] = s.end.v[i];
+  }
+  std::memcpy(q, s.end.q, sizeof(double) * r);
+  return status;
+}
+
+} // namespace
+
 qv_step_status stepBackwardEuler(qv_instance& s) {
+  if (s.config.solver == QV_SOLVER_MINIMIZE) return minimizing(s);
   const double h = s.config.time_step;
   const int r = s.r;
   double *q = s.q, *v = s.v, *a = s.a;
   std::memcpy(s.end.v, v, sizeof(double) * r);
   qv_step_status status = QV_STEP_OK;
-  for (int it = 0; it < s.config.newton_iterations; ++it) {
+  for (int it = 0; it < s.config.newton_iterations; ++it, ++s.lastStep.newton_iterations) {
     for (int i = 0; i < r; ++i) s.end.q[i] = q[i] + h * s.end.v[i];
     const double* J = evaluateForces(s, s.end.q);
     for (int i = 0; i < r; ++i)

@@ -1,19 +1,47 @@
-// Implicit Newmark, beta = 1/4, gamma = 1/2 (the trapezoidal rule; Barbic & James 2005): Newton
-// on the end-of-step acceleration, starting from the last one.
+// Implicit Newmark, beta = 1/4, gamma = 1/2 (the trapezoidal rule; Barbic & James 2005). The
+// minimising solver (incremental_potential.h) by default; QV_SOLVER_NEWTON: Newton on the
+// end-of-step acceleration, starting from the last one.
 #include <cstring>
 
 #include "../dynamics.h"
+#include "incremental_potential.h"
 #include "integrator.h"
 
 namespace quiver::rt {
 
+namespace {
+
+// The end of the step as the minimum of its incremental potential, with Newmark's own acceleration
+// a' = 4/h^2 (x - qt) (the equations of motion's at convergence; bounded by the potential when the
+// iteration cap comes first), or none where the step was held back.
+qv_step_status minimizing(qv_instance& s) {
+  const double h = s.config.time_step;
+  const int r = s.r;
+  double *q = s.q, *v = s.v, *a = s.a;
+  for (int i = 0; i < r; ++i) {
+    s.work.predictor[i] = q[i] + h * v[i] + 0.25 * h * h * a[i];
+    s.work.predictorVelocity[i] = v[i] + 0.5 * h * a[i];
+    s.end.q[i] = q[i] + h * v[i] + 0.5 * h * h * a[i];  // the guess: the last acceleration kept
+  }
+  const double w = 4 / (h * h);
+  const qv_step_status status = minimizeStep(s, StepPredictor{w, 2 / h, h});
+  for (int i = 0; i < r; ++i) s.end.a[i] = s.lastStep.held_back ? 0.0 : w * (s.end.q[i] - s.work.predictor[i]);
+  std::memcpy(q, s.end.q, sizeof(double) * r);
+  std::memcpy(v, s.end.v, sizeof(double) * r);
+  std::memcpy(a, s.end.a, sizeof(double) * r);
+  return status;
+}
+
+} // namespace
+
 qv_step_status stepImplicitNewmark(qv_instance& s) {
+  if (s.config.solver == QV_SOLVER_MINIMIZE) return minimizing(s);
   const double h = s.config.time_step, beta = 0.25, gamma = 0.5;
   const int r = s.r;
   double *q = s.q, *v = s.v, *a = s.a;
   std::memcpy(s.end.a, a, sizeof(double) * r);
   qv_step_status status = QV_STEP_OK;
-  for (int it = 0; it < s.config.newton_iterations; ++it) {
+  for (int it = 0; it < s.config.newton_iterations; ++it, ++s.lastStep.newton_iterations) {
     for (int i = 0; i < r; ++i) {
       s.end.q[i] = q[i] + h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * s.end.a[i]);
       s.end.v[i] = v[i] + h * ((1 - gamma) * a[i] + gamma * s.end.a[i]);

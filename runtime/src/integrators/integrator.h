@@ -16,6 +16,13 @@ struct IntegratorEntry {
 // Indexed by qv_integrator: the one table of names.
 extern const IntegratorEntry kIntegrators[QV_INTEGRATOR_COUNT];
 
+struct SolverEntry {
+  qv_solver id;
+  const char* name;
+  const char* description;
+};
+extern const SolverEntry kSolvers[QV_SOLVER_COUNT];
+
 qv_step_status stepImplicitNewmark(qv_instance& s);
 qv_step_status stepBackwardEuler(qv_instance& s);
 qv_step_status stepCentralDifferences(qv_instance& s);

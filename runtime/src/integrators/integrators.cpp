@@ -8,4 +8,9 @@ const IntegratorEntry kIntegrators[QV_INTEGRATOR_COUNT] = {
     {QV_INTEGRATOR_CENTRAL_DIFFERENCES, "central", "central differences", stepCentralDifferences},
 };
 
+const SolverEntry kSolvers[QV_SOLVER_COUNT] = {
+    {QV_SOLVER_MINIMIZE, "minimize", "minimise the incremental potential"},
+    {QV_SOLVER_NEWTON, "newton", "fixed Newton iterations (Barbic & James)"},
+};
+
 } // namespace quiver::rt

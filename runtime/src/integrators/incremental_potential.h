@@ -1,0 +1,36 @@
+#pragma once
+// Implicit steps as minimisation (QV_SOLVER_MINIMIZE). Implicit Newmark (beta = 1/4, gamma = 1/2)
+// and backward Euler both make the end-of-step position x a stationary point of
+//   Phi(x) = w/2 |x - qt|^2 + E(x) + S(x) - f^T x + 1/(2s) v(x)^T C0 v(x),   v(x) = v0 + s (x - qt),
+// with M = I, E the elastic energy, S the state forces' potential (loads.h), f this step's constant
+// forces and C0 = alpha I + beta K(0) (Rayleigh damping with the rest stiffness: a potential that is
+// never negative). grad Phi = 0 is the integrator's own equation; its Hessian is
+// w I + K(x) + J + s C0. Each step's predictor:
+//   Newmark:        qt = q + h v + h^2/4 a,  w = 4/h^2,  v0 = v + h/2 a,  s = 2/h
+//   backward Euler: qt = q + h v,            w = 1/h^2,  v0 = v,          s = 1/h
+// Newton on Phi, the Hessian shifted to positive definite where K(x) is not, backtracking on Phi
+// (Armijo), until |grad Phi| <= newton_tolerance x (|w (x - qt)| + |R + S'| + |f| + |C0 v|) or
+// newton_iterations. Then the energy budget: with H = |v|^2/2 + E + S - f^T q at this step's loads,
+// a step may not end with more H than it began with, plus the slack earlier steps' discretisation
+// lost (the trapezoidal rule trades energy back and forth on a nonlinear model; without the slack
+// the budget would damp it), less what damping dissipates. What the integrator would add beyond
+// it is taken out of the velocity (qv_step_report::energy_removed). So without loads and damping H
+// never exceeds its first value, and under bounded loads the state stays bounded.
+#include "../instance.h"
+
+namespace quiver::rt {
+
+struct StepPredictor {
+  double w;  // inertia weight
+  double s;  // dv/dx
+  double h;  // the time step
+};
+
+// (C0 v)_i, C0 = alpha I + beta K(0).
+double restDampingForce(const qv_instance& s, int i, const double* v);
+
+// Runs the minimisation from the guess in s.end.q, with qt in s.work.predictor and v0 in
+// s.work.predictorVelocity. On return s.end.q is x and s.end.v is v(x) after the energy budget.
+qv_step_status minimizeStep(qv_instance& s, const StepPredictor& predictor);
+
+} // namespace quiver::rt
