@@ -120,6 +120,7 @@ int main(int argc, char** argv) {
   simOptions.addTo(*sim);
   quiver::app::addIntegratorOption(*sim, simOptions.step.integrator);
   quiver::app::addElasticityOption(*sim, simOptions.step.elasticity);
+  quiver::app::addSolverOption(*sim, simOptions.step.solver);
   CLI::App* render = app.add_subcommand("render", "Draw MODEL.qvr without a display: rest, after (or during) a scenario, or its modes; PNG, GIF or image sequence");
   quiver::app::RenderOptions renderOptions;
   render->add_option("model", path, "Model file (.qvr)")->required();

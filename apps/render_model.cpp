@@ -89,9 +89,8 @@ void RenderOptions::addTo(CLI::App& app) {
   app.add_option("--every", every, "Animated scenario: a frame every k-th step")
       ->capture_default_str()
       ->check(Positive);
-  // Pictures are for looking at, not timing: enough Newton iterations that a strong pull is drawn converged.
-  scenario.step.newton = 3;
   scenario.addScenarioTo(app);
+  addSolverOption(app, scenario.step.solver);
 }
 
 int renderModel(const std::string& path, const RenderOptions& o) {
@@ -126,7 +125,7 @@ int renderModel(const std::string& path, const RenderOptions& o) {
     // The runtime resets a diverged state to rest; say so rather than show a rest shape as "loaded".
     if (result.failedSteps > 0)
       std::fprintf(stderr, "quiver render: warning: the scenario diverged and the model was reset to rest %d times; "
-                           "try a smaller load or more --newton iterations\n", result.failedSteps);
+                           "try a smaller load or --solver minimize\n", result.failedSteps);
   }
   frames.finish();
   return 0;

@@ -26,9 +26,13 @@ void RuntimeTarget::setSprings(const std::vector<int>& vertices, const std::vect
 void RuntimeTarget::clearSprings() { qv_instance_clear_constraint(instance_.get(), 0); }
 
 int RuntimeTarget::step(int& newton) {
-  newton = instance_.config().integrator == QV_INTEGRATOR_CENTRAL_DIFFERENCES ? 0 : instance_.config().newton_iterations;
   const qv_step_status status = qv_instance_step(instance_.get());
+  qv_step_report report;
+  qv_instance_last_step(instance_.get(), &report);
+  newton = report.newton_iterations;
   indefinite_ += status == QV_STEP_INDEFINITE;
+  heldBack_ += report.held_back;
+  energyRemoved_ += report.energy_removed;
   return status == QV_STEP_RESET ? 1 : 0;
 }
 

@@ -22,11 +22,14 @@ public:
 
   const RuntimeInstance& instance() const { return instance_; }
   int indefiniteSteps() const { return indefinite_; }
+  int heldBackSteps() const { return heldBack_; }
+  double energyRemoved() const { return energyRemoved_; }  // J, by the minimising solver's energy budget
 
 private:
   const RuntimeModel& model_;
   RuntimeInstance instance_;
-  int indefinite_ = 0;
+  int indefinite_ = 0, heldBack_ = 0;
+  double energyRemoved_ = 0;
 };
 
 } // namespace quiver::app

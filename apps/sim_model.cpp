@@ -21,11 +21,15 @@ int simulateModel(const std::string& path, const SimOptions& o) {
     j["time_step_s"] = target.timeStep();
     j["integrator"] = qv_integrator_name(o.step.integrator);
     j["elasticity"] = qv_elasticity_name(o.step.elasticity);
+    j["solver"] = qv_solver_name(target.instance().config().solver);
     j["step_us_median"] = median;
     j["step_us_p99"] = p99;
     j["steps_per_second"] = 1e6 * o.steps / total;
     j["resets"] = result.failedSteps;
     j["indefinite_steps"] = target.indefiniteSteps();
+    j["newton_iterations_mean"] = static_cast<double>(result.newtonIterations) / o.steps;
+    j["held_back_steps"] = target.heldBackSteps();
+    j["energy_removed_J"] = target.energyRemoved();
     std::cout << j.dump(1) << "\n";
   } else {
     std::cout << "quiver sim: " << o.steps << " steps of r = " << model.info().r << ": median " << median << " us, p99 "

@@ -29,7 +29,10 @@ void SimOptions::addScenarioTo(CLI::App& app) {
   app.add_option("--stiffness", stiffness, "Drag: penalty spring per vertex, N/m")->capture_default_str();
   app.add_flag("--gravity", gravity, "Gravity, 9.81 m/s^2 along -z");
   app.add_option("--dt", step.timeStep, "Time step, s")->check(Positive);
-  app.add_option("--newton", step.newton, "Newton iterations per implicit step (full space: the most)")->capture_default_str();
+  app.add_option("--newton", step.newton,
+                 "Newton iterations per implicit step: the most (--solver minimize, default 8; full space, default 20) "
+                 "or exactly (--solver newton)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--alpha", step.alpha, "Mass-proportional damping, 1/s");
   app.add_option("--beta", step.beta, "Stiffness-proportional damping, s");
   app.add_option("--scenario", scenarioFile,

@@ -27,7 +27,7 @@ CLI::Option* addChoice(CLI::App& app, const std::string& flag, Enum& target, int
 
 bool StepSettings::operator==(const StepSettings& o) const {
   return integrator == o.integrator && elasticity == o.elasticity && timeStep == o.timeStep && newton == o.newton &&
-         alpha == o.alpha && beta == o.beta;
+         solver == o.solver && alpha == o.alpha && beta == o.beta;
 }
 
 qv_instance_config instanceConfig(const qv_model* model, const StepSettings& s) {
@@ -36,7 +36,8 @@ qv_instance_config instanceConfig(const qv_model* model, const StepSettings& s) 
   c.integrator = s.integrator;
   c.elasticity = s.elasticity;
   if (s.timeStep > 0) c.time_step = s.timeStep;
-  c.newton_iterations = s.newton;
+  if (s.newton != 0) c.newton_iterations = s.newton;
+  c.solver = s.solver;
   if (s.alpha >= 0) c.rayleigh_alpha = s.alpha;
   if (s.beta >= 0) c.rayleigh_beta = s.beta;
   return c;
@@ -50,6 +51,10 @@ CLI::Option* addIntegratorOption(CLI::App& app, qv_integrator& integrator) {
 CLI::Option* addElasticityOption(CLI::App& app, qv_elasticity& elasticity) {
   return addChoice(app, "--elasticity", elasticity, QV_ELASTICITY_COUNT, qv_elasticity_name, qv_elasticity_description,
                    qv_elasticity_from_name);
+}
+
+CLI::Option* addSolverOption(CLI::App& app, qv_solver& solver) {
+  return addChoice(app, "--solver", solver, QV_SOLVER_COUNT, qv_solver_name, qv_solver_description, qv_solver_from_name);
 }
 
 } // namespace quiver::app

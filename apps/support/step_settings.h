@@ -14,7 +14,8 @@ struct StepSettings {
   qv_integrator integrator = QV_INTEGRATOR_IMPLICIT_NEWMARK;
   qv_elasticity elasticity = QV_ELASTICITY_STVK;
   double timeStep = 0;           // s; 0: the model's
-  int newton = 1;                // Newton iterations per implicit step
+  int newton = 0;                // Newton iterations per implicit step (the most, or exactly: qv_solver); 0: the runtime's default
+  qv_solver solver = QV_SOLVER_MINIMIZE;
   double alpha = -1, beta = -1;  // Rayleigh damping; negative: the model's
 
   bool operator==(const StepSettings& o) const;
@@ -26,8 +27,9 @@ inline constexpr double kGravity = 9.81;
 // The model's defaults, overridden where `settings` says.
 qv_instance_config instanceConfig(const qv_model* model, const StepSettings& settings);
 
-// --integrator and --elasticity: a value is one of the runtime's names, stored as the enum.
+// --integrator, --elasticity and --solver: a value is one of the runtime's names, stored as the enum.
 CLI::Option* addIntegratorOption(CLI::App& app, qv_integrator& integrator);
 CLI::Option* addElasticityOption(CLI::App& app, qv_elasticity& elasticity);
+CLI::Option* addSolverOption(CLI::App& app, qv_solver& solver);
 
 } // namespace quiver::app

@@ -114,6 +114,7 @@ public:
     edited_ = session_.settings();
     for (int i = 0; i < QV_INTEGRATOR_COUNT; ++i) integratorLabels_[i] = qv_integrator_description(qv_integrator(i));
     for (int i = 0; i < QV_ELASTICITY_COUNT; ++i) elasticityLabels_[i] = qv_elasticity_description(qv_elasticity(i));
+    for (int i = 0; i < QV_SOLVER_COUNT; ++i) solverLabels_[i] = qv_solver_description(qv_solver(i));
     if (!o.dragScript.empty()) script_ = DragScript::load(o.dragScript);
     if (!o.showMode.empty()) {
       const size_t colon = o.showMode.find(':');
@@ -273,8 +274,14 @@ private:
         edited_.step.timeStep = stepMs / 1000;
       if (edited_.step.integrator == QV_INTEGRATOR_CENTRAL_DIFFERENCES)
         ImGui::Text("stable below %.3f ms", 1000 * session_.stableTimeStep());
-      else
-        ImGui::SliderInt("Newton iterations", &edited_.step.newton, 1, 5);
+      else {
+        int solver = edited_.step.solver;
+        if (ImGui::Combo("solver", &solver, solverLabels_, QV_SOLVER_COUNT)) edited_.step.solver = qv_solver(solver);
+        int newton = session_.config().newton_iterations;
+        if (ImGui::SliderInt(edited_.step.solver == QV_SOLVER_MINIMIZE ? "most Newton iterations" : "Newton iterations",
+                             &newton, 1, 20))
+          edited_.step.newton = newton;
+      }
       double alpha = session_.config().rayleigh_alpha, beta = session_.config().rayleigh_beta;
       if (ImGui::InputDouble("damping alpha, 1/s", &alpha, 0, 0, "%.4g", ImGuiInputTextFlags_EnterReturnsTrue))
         edited_.step.alpha = std::max(alpha, 0.0);
@@ -329,6 +336,7 @@ private:
   ViewSettings edited_;
   const char* integratorLabels_[QV_INTEGRATOR_COUNT];  // the panel's menus, from the runtime's tables
   const char* elasticityLabels_[QV_ELASTICITY_COUNT];
+  const char* solverLabels_[QV_SOLVER_COUNT];
   std::string settingsError_;
   std::vector<unsigned> triangles_;
   std::vector<float> positions_, normals_;
@@ -359,9 +367,10 @@ int main(int argc, char** argv) {
   app.add_option("--size", o.size, "Window width,height in pixels")->delimiter(',')->expected(2)->capture_default_str();
   addIntegratorOption(app, o.settings.step.integrator);
   addElasticityOption(app, o.settings.step.elasticity);
+  addSolverOption(app, o.settings.step.solver);
   app.add_option("--dt", o.settings.step.timeStep, "Time step, s (default: the model's)")->check(Positive);
-  app.add_option("--newton", o.settings.step.newton, "Newton iterations per implicit step")
-      ->capture_default_str()
+  app.add_option("--newton", o.settings.step.newton,
+                 "Newton iterations per implicit step: the most (--solver minimize, default 8) or exactly (--solver newton)")
       ->check(CLI::Range(1, 20));
   app.add_flag("--gravity", o.settings.gravity, "Start with gravity, 9.81 m/s^2 along -z");
   app.add_option("--frames", o.frames, "Run this many frames (1/60 s of simulation each), then exit")

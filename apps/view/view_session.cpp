@@ -34,7 +34,8 @@ void ViewSession::configure(const ViewSettings& wanted) {
   const qv_instance_config next = instanceConfig(model_.get(), s.step), now = instance_->config();
   const bool same = next.integrator == now.integrator && next.time_step == now.time_step &&
                     next.newton_iterations == now.newton_iterations && next.rayleigh_alpha == now.rayleigh_alpha &&
-                    next.rayleigh_beta == now.rayleigh_beta && next.elasticity == now.elasticity;
+                    next.rayleigh_beta == now.rayleigh_beta && next.elasticity == now.elasticity &&
+                    next.solver == now.solver;
   std::vector<double> q, v;  // the state a new instance continues from
   if (!same) {
     auto replacement = std::make_unique<RuntimeInstance>(model_, next);  // throws before anything changes

@@ -18,8 +18,7 @@ namespace quiver::app {
 enum class ModeKind { None = 0, LinearMode = 1, BasisVector = 2 };
 
 struct ViewSettings {
-  // Two Newton iterations, not the paper's one: they keep a stiff mouse spring converged.
-  StepSettings step{QV_INTEGRATOR_IMPLICIT_NEWMARK, QV_ELASTICITY_STVK, 0, 2, -1, -1};
+  StepSettings step;
   bool gravity = false;
   double springStiffness = 0;    // N/m of the mouse spring; 0: scaled to the model (see ViewSession)
 

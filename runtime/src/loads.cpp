@@ -11,6 +11,7 @@ void Loads::carve(BlockCarver& c, int reducedSize, int slotCount) {
   slots = slotCount;
   const size_t rr = static_cast<size_t>(r) * r;
   stepForce = c.take<double>(r);
+  lastStepForce = c.take<double>(r);
   gravityForce = c.take<double>(r);
   constraintK = c.take<double>(rr);
   constraintB = c.take<double>(r);
@@ -21,6 +22,7 @@ void Loads::carve(BlockCarver& c, int reducedSize, int slotCount) {
 
 void Loads::clear() {
   std::memset(stepForce, 0, sizeof(double) * r);
+  std::memset(lastStepForce, 0, sizeof(double) * r);
   std::memset(gravityForce, 0, sizeof(double) * r);
   std::memset(slotActive, 0, sizeof(int) * slots);
   combineConstraints();
@@ -38,7 +40,16 @@ const double* Loads::addStateForces(const double* q, double* force, double* ener
   return constraintK;
 }
 
-void Loads::endStep() { std::memset(stepForce, 0, sizeof(double) * r); }
+void Loads::endStep() {
+  std::memcpy(lastStepForce, stepForce, sizeof(double) * r);
+  std::memset(stepForce, 0, sizeof(double) * r);
+}
+
+bool Loads::changedSinceLastStep() {
+  const bool was = changed || std::memcmp(stepForce, lastStepForce, sizeof(double) * r) != 0;
+  changed = false;
+  return was;
+}
 
 void Loads::addVertexForce(const qv_model& m, qv_elasticity elasticity, const double* q, int vertex,
                            const double force[3]) {
@@ -58,6 +69,7 @@ void Loads::addReducedForce(const double* force) {
 }
 
 void Loads::setGravity(const qv_model& m, const double g[3]) {
+  changed = true;
   const double* G = m.gravity;  // 3 x r: row a = U^T M e_a
   for (int j = 0; j < r; ++j) gravityForce[j] = G[j] * g[0] + G[r + j] * g[1] + G[2 * r + j] * g[2];
 }
@@ -81,10 +93,12 @@ void Loads::setConstraint(const qv_model& m, int slot, const int* vertices, int 
     }
   }
   slotActive[slot] = 1;
+  changed = true;
   combineConstraints();
 }
 
 void Loads::clearConstraint(int slot) {
+  changed = true;
   slotActive[slot] = 0;
   combineConstraints();
 }

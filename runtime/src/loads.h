@@ -28,6 +28,8 @@ struct Loads {
   double* slotK = nullptr;         // per slot
   double* slotB = nullptr;
   int* slotActive = nullptr;
+  double* lastStepForce = nullptr; // the per-step forces of the step before
+  bool changed = false;            // a persistent load was set since the last step
 
   // Takes the arrays from `c` (null pointers while it measures).
   void carve(BlockCarver& c, int reducedSize, int slotCount);
@@ -38,6 +40,9 @@ struct Loads {
   // it: every state force it steps with must have one, up to a constant).
   const double* addStateForces(const double* q, double* force, double* energy = nullptr) const;
   void endStep();  // the per-step forces are spent
+  // Whether this step's loads differ from the last step's (a per-step force applied again unchanged
+  // is no change); clears the record.
+  bool changedSinceLastStep();
 
   // `q`: the current state, to rotate the force into the vertex's frame under modal warping.
   void addVertexForce(const qv_model& model, qv_elasticity elasticity, const double* q, int vertex,

@@ -83,10 +83,10 @@ class QuiverView(unittest.TestCase):
 
     def test_a_scripted_click_on_the_panel_turns_gravity_on(self):
         # The panel opens at the top left with ImGui 1.86's default font: the gravity checkbox sits at
-        # pixel (27, 313) of a 1280 x 800 window. The click is the panel's: no grab.
+        # pixel (27, 336) of a 1280 x 800 window. The click is the panel's: no grab.
         click = os.path.join(self.tmp.name, "click.txt")
         with open(click, "w") as f:
-            f.write("10 press 0.021 0.391\n12 release\n")
+            f.write("10 press 0.021 0.42\n12 release\n")
         plain, _ = self.shot("no_click.png", "--size", "1280,800")
         fallen, out = self.shot("gravity.png", "--size", "1280,800", "--drag-script", click)
         self.assertIn("0 grabs", out)

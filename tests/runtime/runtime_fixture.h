@@ -70,4 +70,15 @@ struct TestModel {
   }
 };
 
+// An instance owned for the length of a test.
+struct Instance {
+  qv_instance* s = nullptr;
+  Instance(const qv_model* model, const qv_instance_config& config) {
+    EXPECT_EQ(qv_instance_create(model, &config, nullptr, &s), QV_OK);
+  }
+  ~Instance() { qv_instance_destroy(s); }
+  Instance(const Instance&) = delete;
+  Instance& operator=(const Instance&) = delete;
+};
+
 } // namespace quiver::test

@@ -11,13 +11,7 @@ using namespace quiver;
 
 namespace {
 
-struct Instance {
-  qv_instance* s = nullptr;
-  Instance(const qv_model* model, const qv_instance_config& config) {
-    EXPECT_EQ(qv_instance_create(model, &config, nullptr, &s), QV_OK);
-  }
-  ~Instance() { qv_instance_destroy(s); }
-};
+using test::Instance;
 
 Eigen::VectorXd state(const qv_instance* s, int r) {
   Eigen::VectorXd q(r);

@@ -212,8 +212,8 @@ typedef struct qv_step_report {
   int line_search_cuts;    /* QV_SOLVER_MINIMIZE: step halvings in all */
   int converged;           /* QV_SOLVER_MINIMIZE: 1 when the gradient met newton_tolerance */
   double gradient;         /* QV_SOLVER_MINIMIZE: |gradient| / force scale at the end */
-  int held_back;           /* QV_SOLVER_MINIMIZE: 1 when the end position alone held more energy than the step began
-                              with (the iteration cap came first), so it was drawn back toward the start and stopped */
+  int held_back;           /* QV_SOLVER_MINIMIZE: 1 when the end position alone held more energy than the step may
+                              end with, so it was drawn back toward the start (the velocity keeps what is left) */
   double energy_removed;   /* QV_SOLVER_MINIMIZE: kinetic energy (J) the step took out so as not to add energy */
 } qv_step_report;
 QV_API void qv_instance_last_step(const qv_instance* instance, qv_step_report* report);

@@ -115,6 +115,9 @@ qv_step_status minimizeStep(qv_instance& s, const StepPredictor& p) {
   // What the step may end with: what it began with, what earlier steps' discretisation lost and
   // may win back (the trapezoidal rule trades a little energy back and forth on nonlinear models),
   // less what damping dissipates in it (below).
+  // Loads that changed since the last step start the budget anew: what the discretisation lost
+  // under the old loads is not owed under the new ones.
+  if (s.loads.changedSinceLastStep()) s.energySlack = 0;
   double budget = stepEnergy(s, s.q, s.v, s.elasticEnergyAtState) + s.energySlack;
   const double* qt = s.work.predictor;
   const double* v0 = s.work.predictorVelocity;
@@ -127,8 +130,9 @@ qv_step_status minimizeStep(qv_instance& s, const StepPredictor& p) {
   qv_step_report& report = s.lastStep;
   for (int it = 0;; ++it) {
     const double gradient = norm(s.work.gradient, r);
+    if (!std::isfinite(gradient) || !std::isfinite(at.phi)) return QV_STEP_RESET;  // non-finite input
     report.gradient = gradient / (at.scale + 1e-300);
-    if (gradient <= s.config.newton_tolerance * at.scale || !(gradient > 0)) {
+    if (gradient <= s.config.newton_tolerance * at.scale) {
       report.converged = 1;
       break;
     }
@@ -138,7 +142,10 @@ qv_step_status minimizeStep(qv_instance& s, const StepPredictor& p) {
     if (failed) break;
     ++report.newton_iterations;
     const double slope = dot(s.work.gradient, s.work.correction, r);  // < 0: a descent direction
-    // Backtracking: the first step length that lowers Phi enough (Armijo); none, and x stays.
+    // Backtracking: the first step length that lowers Phi enough (Armijo), or, near the minimum
+    // where Phi's change drowns in its rounding, one that keeps Phi within rounding and lowers the
+    // gradient. None, and x stays.
+    const double roundoff = 1e-12 * std::fabs(at.phi);
     double length = 1;
     bool accepted = false;
     double trialElastic = 0;
@@ -146,7 +153,8 @@ qv_step_status minimizeStep(qv_instance& s, const StepPredictor& p) {
     for (int cut = 0; cut < 30 && !accepted; ++cut, length *= 0.5) {
       for (int i = 0; i < r; ++i) s.work.trial[i] = x[i] + length * s.work.correction[i];
       trial = minimizer.evaluate(s.work.trial, &trialElastic);
-      accepted = trial.phi <= at.phi + 1e-4 * length * slope;
+      accepted = trial.phi <= at.phi + 1e-4 * length * slope ||
+                 (trial.phi <= at.phi + roundoff && norm(s.work.gradient, r) < gradient);
       if (!accepted) ++report.line_search_cuts;
     }
     if (!accepted) {
@@ -160,27 +168,28 @@ qv_step_status minimizeStep(qv_instance& s, const StepPredictor& p) {
   // Damping's share: h v_mid^T C0 v_mid, exact for the trapezoidal rule's linear damping.
   for (int i = 0; i < r; ++i) s.work.trial[i] = 0.5 * (s.v[i] + velocity[i]);
   for (int i = 0; i < r; ++i) budget -= p.h * s.work.trial[i] * restDampingForce(s, i, s.work.trial);
-  // The budget holds: never end a step with more. Where the position alone holds more (an
-  // iteration cap reached far from the minimum), draw it back toward the start, whose potential is
-  // within the budget, and stop it there.
+  // The budget holds: never end a step with more. Where the position alone holds more, draw it
+  // back toward the start, whose potential is within the budget; the velocity then gets what is
+  // left (below).
   const double energyBefore = budget;
   if (stepEnergy(s, x, nullptr, elastic) > energyBefore) {
-    const double before = 0.5 * dot(velocity, velocity, r);
+    // Bisection on x(t) = q + t (x - q) for the farthest t whose potential is within the budget
+    // (t = 0, the start, is); 12 halvings leave t within 1/4096 of it.
     std::memcpy(s.work.trial, x, sizeof(double) * r);  // the far end of the segment
-    double t = 1;
-    bool within = false;
-    for (int cut = 0; cut < 40 && !within; ++cut) {
-      t *= 0.5;
+    double within = 0, beyond = 1, withinElastic = s.elasticEnergyAtState;
+    for (int cut = 0; cut < 12; ++cut) {
+      const double t = 0.5 * (within + beyond);
       for (int i = 0; i < r; ++i) x[i] = s.q[i] + t * (s.work.trial[i] - s.q[i]);
-      elastic = elasticEnergy(*s.model, s.config.elasticity, x, s.work.polynomialScratch);
-      within = stepEnergy(s, x, nullptr, elastic) <= energyBefore;
+      const double e = elasticEnergy(*s.model, s.config.elasticity, x, s.work.polynomialScratch);
+      if (stepEnergy(s, x, nullptr, e) <= energyBefore) {
+        within = t;
+        withinElastic = e;
+      } else {
+        beyond = t;
+      }
     }
-    if (!within) {
-      std::memcpy(x, s.q, sizeof(double) * r);
-      elastic = s.elasticEnergyAtState;
-    }
-    std::memset(velocity, 0, sizeof(double) * r);
-    report.energy_removed = before;
+    for (int i = 0; i < r; ++i) x[i] = s.q[i] + within * (s.work.trial[i] - s.q[i]);
+    elastic = withinElastic;
     report.held_back = 1;
   }
   const double energyAfter = stepEnergy(s, x, velocity, elastic);
@@ -188,7 +197,7 @@ qv_step_status minimizeStep(qv_instance& s, const StepPredictor& p) {
     const double kinetic = 0.5 * dot(velocity, velocity, r), potential = energyAfter - kinetic;
     const double keep = potential < energyBefore && kinetic > 0 ? std::sqrt((energyBefore - potential) / kinetic) : 0.0;
     for (int i = 0; i < r; ++i) velocity[i] *= keep;
-    report.energy_removed += kinetic * (1 - keep * keep);
+    report.energy_removed = kinetic * (1 - keep * keep);
   }
   // A step held back forfeits the slack: what it removed is not to be won back.
   s.energySlack = report.held_back ? 0.0 : std::fmax(0.0, energyBefore - stepEnergy(s, x, velocity, elastic));

@@ -12,8 +12,8 @@
 // (Armijo), until |grad Phi| <= newton_tolerance x (|w (x - qt)| + |R + S'| + |f| + |C0 v|) or
 // newton_iterations. Then the energy budget: with H = |v|^2/2 + E + S - f^T q at this step's loads,
 // a step may not end with more H than it began with, plus the slack earlier steps' discretisation
-// lost (the trapezoidal rule trades energy back and forth on a nonlinear model; without the slack
-// the budget would damp it), less what damping dissipates. What the integrator would add beyond
+// lost since the loads last changed (the trapezoidal rule trades energy back and forth on a
+// nonlinear model; without the slack the budget would damp it), less what damping dissipates. What the integrator would add beyond
 // it is taken out of the velocity (qv_step_report::energy_removed). So without loads and damping H
 // never exceeds its first value, and under bounded loads the state stays bounded.
 #include "../instance.h"

@@ -9,8 +9,8 @@ const IntegratorEntry kIntegrators[QV_INTEGRATOR_COUNT] = {
 };
 
 const SolverEntry kSolvers[QV_SOLVER_COUNT] = {
-    {QV_SOLVER_MINIMIZE, "minimize", "minimise the incremental potential"},
-    {QV_SOLVER_NEWTON, "newton", "fixed Newton iterations (Barbic & James)"},
+    {QV_SOLVER_MINIMIZE, "minimize", "minimise potential"},
+    {QV_SOLVER_NEWTON, "newton", "fixed Newton steps"},
 };
 
 } // namespace quiver::rt

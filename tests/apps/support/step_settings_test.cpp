@@ -52,17 +52,19 @@ TEST(StepSettings, TheConfigIsTheDefaultsOverriddenWhereAsked) {
   EXPECT_EQ(same.integrator, defaults.integrator);
   EXPECT_EQ(same.elasticity, defaults.elasticity);
   EXPECT_EQ(same.time_step, defaults.time_step);
-  EXPECT_EQ(same.newton_iterations, 1);
+  EXPECT_EQ(same.newton_iterations, defaults.newton_iterations) << "0: the runtime's default";
+  EXPECT_EQ(same.solver, QV_SOLVER_MINIMIZE);
   EXPECT_EQ(same.rayleigh_alpha, defaults.rayleigh_alpha);
   EXPECT_EQ(same.rayleigh_beta, defaults.rayleigh_beta);
   EXPECT_EQ(same.max_constraints, defaults.max_constraints);
 
-  StepSettings s{QV_INTEGRATOR_BACKWARD_EULER, QV_ELASTICITY_LINEAR, 0.002, 4, 0.5, 0.01};
+  StepSettings s{QV_INTEGRATOR_BACKWARD_EULER, QV_ELASTICITY_LINEAR, 0.002, 4, QV_SOLVER_NEWTON, 0.5, 0.01};
   const qv_instance_config c = instanceConfig(nullptr, s);
   EXPECT_EQ(c.integrator, QV_INTEGRATOR_BACKWARD_EULER);
   EXPECT_EQ(c.elasticity, QV_ELASTICITY_LINEAR);
   EXPECT_EQ(c.time_step, 0.002);
   EXPECT_EQ(c.newton_iterations, 4);
+  EXPECT_EQ(c.solver, QV_SOLVER_NEWTON);
   EXPECT_EQ(c.rayleigh_alpha, 0.5);
   EXPECT_EQ(c.rayleigh_beta, 0.01);
   s.alpha = 0;  // zero is a value, not "the default"

@@ -1,0 +1,152 @@
+// The minimising solver (QV_SOLVER_MINIMIZE) against what it must guarantee: a converged step solves
+// the integrator's own equations (checked against Barbic & James's Newton iterated to convergence),
+// energy never grows without loads or damping, no bounded load resets it, non-finite input does.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Core>
+
+#include "tests/runtime/runtime_fixture.h"
+
+using namespace quiver;
+using test::Instance;
+
+namespace {
+
+Eigen::VectorXd stateOf(const qv_instance* s, int r, int part) {
+  Eigen::VectorXd q(r), v(r), a(r);
+  qv_instance_get_state(s, q.data(), v.data(), a.data());
+  return part == 0 ? q : part == 1 ? v : a;
+}
+
+double totalEnergy(const qv_instance* s) {
+  double kinetic = 0, elastic = 0;
+  qv_instance_energies(s, &kinetic, &elastic);
+  return kinetic + elastic;
+}
+
+} // namespace
+
+TEST(Solver, AConvergedStepSolvesTheIntegratorsEquations) {
+  test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  const int r = m.info.r, tip = m.tipVertex();
+  for (qv_integrator integrator : {QV_INTEGRATOR_IMPLICIT_NEWMARK, QV_INTEGRATOR_BACKWARD_EULER}) {
+    qv_instance_config config;
+    qv_instance_config_init(&config, m.model);
+    config.integrator = integrator;
+    config.rayleigh_alpha = 2;  // K-proportional damping differs on purpose between the solvers (K(0) / K(q))
+    config.rayleigh_beta = 0;
+    config.newton_iterations = 40;
+    config.newton_tolerance = 1e-10;
+    Instance minimizing(m.model, config);
+    config.solver = QV_SOLVER_NEWTON;
+    Instance newton(m.model, config);
+    const double pull[3] = {0, 1.0, -4.0};
+    double worst = 0, largest = 0;
+    for (int step = 0; step < 200; ++step) {
+      for (qv_instance* s : {minimizing.s, newton.s})
+        if (step < 80) qv_instance_add_vertex_force(s, tip, pull);
+      ASSERT_NE(qv_instance_step(minimizing.s), QV_STEP_RESET);
+      ASSERT_NE(qv_instance_step(newton.s), QV_STEP_RESET);
+      qv_step_report report;
+      qv_instance_last_step(minimizing.s, &report);
+      EXPECT_TRUE(report.converged) << "step " << step << ": " << report.newton_iterations << " iterations, " << report.line_search_cuts << " cuts, gradient " << report.gradient;
+      EXPECT_EQ(report.held_back, 0);
+      worst = std::max(worst, (stateOf(minimizing.s, r, 0) - stateOf(newton.s, r, 0)).norm());
+      largest = std::max(largest, stateOf(newton.s, r, 0).norm());
+    }
+    EXPECT_LT(worst, 1e-8 * largest) << qv_integrator_name(integrator);
+    EXPECT_GT(largest, 0.01) << "the pull must bend the beam visibly";
+  }
+}
+
+TEST(Solver, WithoutLoadsOrDampingTheEnergyNeverGrows) {
+  test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  const int r = m.info.r;
+  for (qv_integrator integrator : {QV_INTEGRATOR_IMPLICIT_NEWMARK, QV_INTEGRATOR_BACKWARD_EULER}) {
+    for (double h : {1.0 / 240, 1.0 / 30})
+    for (double scale : {0.1, 1.0}) {
+      qv_instance_config config;
+      qv_instance_config_init(&config, m.model);
+      config.integrator = integrator;
+      config.rayleigh_alpha = config.rayleigh_beta = 0;
+      config.time_step = h;
+      Instance inst(m.model, config);
+      // A large, strongly nonlinear start: every coordinate deflected, the tip by about a third of the length.
+      Eigen::VectorXd q0(r);
+      for (int i = 0; i < r; ++i) q0[i] = scale * (i % 2 ? -0.3 : 0.4) / (1 + i);
+      qv_instance_set_state(inst.s, q0.data(), nullptr, nullptr);
+      const double initial = totalEnergy(inst.s);
+      double highest = initial, last = initial;
+      for (int step = 0; step < 2000; ++step) {
+        ASSERT_NE(qv_instance_step(inst.s), QV_STEP_RESET);
+        last = totalEnergy(inst.s);
+        highest = std::max(highest, last);
+      }
+      EXPECT_LE(highest, initial * (1 + 1e-12)) << qv_integrator_name(integrator) << " at h = " << h;
+      RecordProperty(std::string(qv_integrator_name(integrator)) + "_drift_h" + std::to_string(h) + "_scale" + std::to_string(scale),
+                     std::to_string((last - initial) / initial));
+      std::printf("%s, h = %.4f s, start %.1f: energy %.4g J at the start, at most %+.2e relative above it, %+.2f%% after 2000 steps\n",
+                  qv_integrator_name(integrator), h, scale, initial, (highest - initial) / initial, 100 * (last - initial) / initial);
+    }
+  }
+}
+
+TEST(Solver, NoBoundedLoadResetsItNonFiniteInputDoes) {
+  test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  const int r = m.info.r, tip = m.tipVertex();
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  Instance inst(m.model, config);
+  // A billion newtons on one vertex of a 6 kg beam, then a spring of 1e7 N/m to a target a kilometre away.
+  const double shove[3] = {0, 0, -1e9};
+  for (int step = 0; step < 5; ++step) {
+    qv_instance_add_vertex_force(inst.s, tip, shove);
+    EXPECT_NE(qv_instance_step(inst.s), QV_STEP_RESET) << "step " << step;
+  }
+  const double far[3] = {1000, 0, 0};
+  ASSERT_EQ(qv_instance_set_constraint(inst.s, 0, &tip, 1, far, 1e7), QV_OK);
+  for (int step = 0; step < 30; ++step) EXPECT_NE(qv_instance_step(inst.s), QV_STEP_RESET) << "step " << step;
+  qv_instance_clear_constraint(inst.s, 0);
+  for (int step = 0; step < 30; ++step) EXPECT_NE(qv_instance_step(inst.s), QV_STEP_RESET) << "released, step " << step;
+  EXPECT_TRUE(stateOf(inst.s, r, 0).allFinite());
+  EXPECT_TRUE(stateOf(inst.s, r, 1).allFinite());
+  EXPECT_GT(stateOf(inst.s, r, 0).norm(), 0) << "moved, not reset";
+  // A NaN force is the caller's mistake: the step resets and says so, and the instance carries on.
+  const double nan[3] = {std::numeric_limits<double>::quiet_NaN(), 0, 0};
+  qv_instance_add_vertex_force(inst.s, tip, nan);
+  EXPECT_EQ(qv_instance_step(inst.s), QV_STEP_RESET);
+  EXPECT_EQ(stateOf(inst.s, r, 0).norm(), 0.0);
+  EXPECT_EQ(qv_instance_step(inst.s), QV_STEP_OK);
+}
+
+TEST(Solver, TheReportSaysWhatTheStepDid) {
+  test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  Instance inst(m.model, config);
+  qv_step_report report;
+  ASSERT_EQ(qv_instance_step(inst.s), QV_STEP_OK);
+  qv_instance_last_step(inst.s, &report);
+  EXPECT_EQ(report.newton_iterations, 0) << "at rest with no load the guess is already the minimum";
+  EXPECT_TRUE(report.converged);
+  const double pull[3] = {0, 0, -3};
+  qv_instance_add_vertex_force(inst.s, m.tipVertex(), pull);
+  qv_instance_step(inst.s);
+  qv_instance_last_step(inst.s, &report);
+  EXPECT_GE(report.newton_iterations, 1);
+  EXPECT_TRUE(report.converged);
+  EXPECT_LE(report.gradient, config.newton_tolerance);
+  config.solver = QV_SOLVER_NEWTON;
+  config.newton_iterations = 3;
+  Instance newton(m.model, config);
+  qv_instance_step(newton.s);
+  qv_instance_last_step(newton.s, &report);
+  EXPECT_EQ(report.newton_iterations, 3) << "Barbic & James: exactly the iterations asked for";
+}
