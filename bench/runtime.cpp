@@ -1,12 +1,14 @@
 // The runtime's hot paths on baked models, single thread (Google Benchmark):
-//   Evaluate/force, Evaluate/force+stiffness, Step (implicit Newmark, 1 Newton iteration),
-//   and ManyObjects: 1000 instances of one model stepped per frame.
+//   Evaluate/force, Evaluate/force+stiffness, Step/newton (implicit Newmark, Barbic & James's one
+//   Newton iteration), Step/minimize (the default solver), both under a load that keeps the object
+//   moving, and ManyObjects: 1000 instances of one model under gravity stepped per frame (both solvers).
 // Peak FMA throughput of this core is measured in the same run (PeakFma) so that the evaluation
 // can be reported as a fraction of it. Each benchmark's label carries a hash of its final state.
 //   bench/runtime.py --build build/release     (bakes the models, runs this, prints the table)
 //   build/release/bench/bench_runtime MODEL.qvr [MODEL.qvr ...] [--benchmark_* flags]
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -90,26 +92,44 @@ void Evaluate(benchmark::State& state, const char* path, bool withStiffness) {
   qv_model_destroy(m.model);
 }
 
-void Step(benchmark::State& state, const char* path) {
+// Gravity, plus twice its pull on the first coordinate flipping every half second, so that every
+// step has work to do (a settled object converges at once and would flatter the solver).
+void Step(benchmark::State& state, const char* path, qv_solver solver) {
   Loaded m(path);
   qv_instance_config config;
   qv_instance_config_init(&config, m.model);
+  config.solver = solver;
+  if (solver == QV_SOLVER_NEWTON) config.newton_iterations = 1;
   qv_instance* s = nullptr;
   qv_instance_create(m.model, &config, nullptr, &s);
   const double g[3] = {0, 0, -9.81};
   qv_instance_set_gravity(s, g);
-  for (auto _ : state) qv_instance_step(s);
+  std::vector<double> push(m.info.r, 0.0);
+  const double amplitude = 2 * 9.81 * std::fabs(qv_model_gravity(m.model)[2 * m.info.r]);
+  long steps = 0, iterations = 0;
+  for (auto _ : state) {
+    push[0] = (steps / 30) % 2 ? amplitude : -amplitude;
+    qv_instance_add_reduced_force(s, push.data());
+    qv_instance_step(s);
+    qv_step_report report;
+    qv_instance_last_step(s, &report);
+    iterations += report.newton_iterations;
+    ++steps;
+  }
   state.counters["r"] = m.info.r;
+  state.counters["newton_per_step"] = static_cast<double>(iterations) / static_cast<double>(steps);
   state.SetLabel("state " + stateHash(s, m.info.r));
   qv_instance_destroy(s);
   qv_model_destroy(m.model);
 }
 
-void ManyObjects(benchmark::State& state, const char* path) {
+void ManyObjects(benchmark::State& state, const char* path, qv_solver solver) {
   Loaded m(path);
   const int objects = static_cast<int>(state.range(0));
   qv_instance_config config;
   qv_instance_config_init(&config, m.model);
+  config.solver = solver;
+  if (solver == QV_SOLVER_NEWTON) config.newton_iterations = 1;
   std::vector<qv_instance*> all(objects);
   const double g[3] = {0, 0, -9.81};
   for (auto& s : all) {
@@ -137,9 +157,14 @@ int main(int argc, char** argv) {
     qv_model_destroy(probe.model);
     benchmark::RegisterBenchmark(("Evaluate/force" + r).c_str(), Evaluate, path, false)->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("Evaluate/force+stiffness" + r).c_str(), Evaluate, path, true)->Unit(benchmark::kMicrosecond);
-    benchmark::RegisterBenchmark(("Step/newmark" + r).c_str(), Step, path)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("Step/newton" + r).c_str(), Step, path, QV_SOLVER_NEWTON)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("Step/minimize" + r).c_str(), Step, path, QV_SOLVER_MINIMIZE)->Unit(benchmark::kMicrosecond);
     if (probe.info.r == 20)
-      benchmark::RegisterBenchmark(("ManyObjects" + r).c_str(), ManyObjects, path)->Arg(1000)->Unit(benchmark::kMillisecond);
+      for (qv_solver solver : {QV_SOLVER_NEWTON, QV_SOLVER_MINIMIZE})
+        benchmark::RegisterBenchmark(("ManyObjects/" + std::string(qv_solver_name(solver)) + r).c_str(), ManyObjects, path,
+                                     solver)
+            ->Arg(1000)
+            ->Unit(benchmark::kMillisecond);
   }
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

@@ -43,19 +43,24 @@ def main():
         return rows.get(name)
     peak = get("PeakFma")
     peak_gflops = peak["GFLOPS"] / 1e9 if peak else float("nan")
+    cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")), "?")
+    print(f"CPU: {cpu}")
     print(f"Peak FMA throughput of this core, measured in the same run: {peak_gflops:.1f} GFLOP/s (AVX-512, double)\n")
-    print("| r | force (us) | force + stiffness (us) | Newmark step (us) | evaluation GFLOP/s | fraction of peak |")
-    print("|---:|---:|---:|---:|---:|---:|")
+    print("| r | force (us) | force + stiffness (us) | Newmark step, fixed Newton (us) | Newmark step, minimise (us) "
+          "| its Newton iterations | evaluation GFLOP/s | fraction of peak |")
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|")
     for r in RANKS:
-        f, fk, st = get(f"Evaluate/force/r{r}"), get(f"Evaluate/force+stiffness/r{r}"), get(f"Step/newmark/r{r}")
+        f, fk = get(f"Evaluate/force/r{r}"), get(f"Evaluate/force+stiffness/r{r}")
+        newton, minimize = get(f"Step/newton/r{r}"), get(f"Step/minimize/r{r}")
         gflops = fk["GFLOPS"] / 1e9
-        print(f"| {r} | {f['real_time']:.2f} | {fk['real_time']:.2f} | {st['real_time']:.2f} | {gflops:.1f} | "
-              f"{gflops / peak_gflops:.0%} |")
-    many = get("ManyObjects/r20/1000")
-    if many:
-        frame = many["real_time"]
-        print(f"\n1000 objects of r = 20 stepped per frame: {frame:.2f} ms per frame on one core "
-              f"({16.667 / frame:.1f}x inside a 60 Hz frame's 16.7 ms).")
+        print(f"| {r} | {f['real_time']:.2f} | {fk['real_time']:.2f} | {newton['real_time']:.2f} | "
+              f"{minimize['real_time']:.2f} | {minimize['newton_per_step']:.2f} | {gflops:.1f} | {gflops / peak_gflops:.0%} |")
+    for solver in ("newton", "minimize"):
+        many = get(f"ManyObjects/{solver}/r20/1000")
+        if many:
+            frame = many["real_time"]
+            print(f"\n1000 objects of r = 20 under gravity, --solver {solver}: {frame:.2f} ms per frame on one core "
+                  f"({16.667 / frame:.1f}x inside a 60 Hz frame's 16.7 ms).")
 
 
 if __name__ == "__main__":
