@@ -27,7 +27,21 @@ int main(int argc, char** argv) {
   app.add_option("--density", s.material.density, "Density in kg/m^3 (> 0); overrides the mesh file's materials");
   app.add_option("--modes", s.modes, "Linear modes k (the six rigid modes of a free object are not counted)")
       ->capture_default_str();
-  app.add_option("--rank", s.rank, "Basis vectors r, at most k + k(k+1)/2 and the free DOFs")->capture_default_str();
+  app.add_option("--rank", s.rank, "Basis vectors r, at most the free DOFs; fewer (with a warning) where --basis yields fewer")
+      ->capture_default_str();
+  std::vector<std::string> kinds;
+  for (BasisKind kind : {BasisKind::Pca, BasisKind::KeepModes, BasisKind::Modes}) kinds.push_back(basisKindName(kind));
+  app.add_option_function<std::string>(
+         "--basis",
+         [&s](const std::string& name) {
+           for (BasisKind kind : {BasisKind::Pca, BasisKind::KeepModes, BasisKind::Modes})
+             if (name == basisKindName(kind)) s.basisKind = kind;
+         },
+         "pca: mass-PCA of the weighted modes and derivatives (Barbic & James); keep-modes: the k modes exactly, then "
+         "derivatives; modes: the first r modes (precompute/stages/basis.h says what each buys)")
+      ->check(CLI::IsMember(kinds))
+      ->default_str("pca");
+  app.add_flag("--exact-rank", s.exactRank, "Fail rather than bake fewer than --rank vectors");
   app.add_option("--basis-from", s.basisFrom,
                  "Use this basis instead of modes + derivatives: FILE.npy or FILE.h5:/dataset, shape (3 x vertices, r) "
                  "in the mesh file's vertex order");

@@ -125,10 +125,11 @@ void checkBakeSettings(const BakeSettings& s) {
   if (std::string bad = checkMaterial(check); !bad.empty()) throw std::invalid_argument(bad);
   if (s.modes < 1) throw std::invalid_argument("--modes must be at least 1");
   if (s.rank < 1) throw std::invalid_argument("--rank must be at least 1");
-  if (s.basisFrom.empty() && s.rank > s.modes + s.modes * (s.modes + 1) / 2)
-    throw std::invalid_argument("--rank " + std::to_string(s.rank) + " exceeds the " +
-                                std::to_string(s.modes + s.modes * (s.modes + 1) / 2) + " vectors that " +
-                                std::to_string(s.modes) + " modes and their derivatives give; raise --modes");
+  const int candidates = s.basisKind == BasisKind::Modes ? s.modes : s.modes + s.modes * (s.modes + 1) / 2;
+  if (s.basisFrom.empty() && s.exactRank && s.rank > candidates)
+    throw std::invalid_argument("--rank " + std::to_string(s.rank) + " exceeds the " + std::to_string(candidates) +
+                                " vectors that --basis " + basisKindName(s.basisKind) + " makes of " +
+                                std::to_string(s.modes) + " modes; raise --modes or drop --exact-rank");
   if (s.output.empty()) throw std::invalid_argument("-o NAME is required");
   if (s.model.basisPrecision != 32 && s.model.basisPrecision != 64)
     throw std::invalid_argument("--basis-precision must be 32 or 64");
@@ -230,10 +231,12 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
                  "), residual " + fixed3(modes.residuals[i]));
 
   ReducedBasis basis;
-  std::string basisSource = "modes+derivatives";
+  std::string basisSource = s.basisKind == BasisKind::Pca ? "modes+derivatives" : basisKindName(s.basisKind);
   if (s.basisFrom.empty()) {
-    const std::string derivativesHash = InputHash().add(modesHash).add(std::string("derivatives 1")).hex();
+    // Version 2: residuals are normwise backward errors.
+    const std::string derivativesHash = InputHash().add(modesHash).add(std::string("derivatives 2")).hex();
     ModalDerivatives derivatives;
+    if (s.basisKind != BasisKind::Modes) {  // the modes-only basis needs none
     clock.run("derivatives", [&] {
       reused = reuseOrCompute(
           reuse, archive, "/derivatives", derivativesHash, derivatives, [&] { return readDerivatives(archive, layout); },
@@ -250,12 +253,19 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
                  " solved, max residual " +
                  fixed3(*std::max_element(derivatives.residuals.begin(), derivatives.residuals.end())) + " [" +
                  fixed3(clock.last()) + " s]");
+    }
     clock.run("basis", [&] {
       BasisSettings settings;
       settings.rank = s.rank;
+      settings.kind = s.basisKind;
+      settings.exactRank = s.exactRank;
       basis = buildBasis(system.mass, layout, modes, derivatives, settings);
-      writeBasis(archive, basis, basisSource, layout, InputHash().add(derivativesHash).add(s.rank).hex());
+      InputHash hash;
+      hash.add(derivativesHash).add(s.rank);
+      if (s.basisKind != BasisKind::Pca) hash.add(basisSource);
+      writeBasis(archive, basis, basisSource, layout, hash.hex());
     });
+    if (!basis.warning.empty() && ctx.rank() == 0) std::fprintf(stderr, "quiver-bake: warning: %s\n", basis.warning.c_str());
   } else {
     basisSource = s.basisFrom;
     clock.run("basis", [&] {
@@ -318,7 +328,8 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   const std::string h5Name = fs::path(finalPath).filename().string();
   std::vector<std::pair<std::string, int64_t>> fields = {{"/modes/vectors", modes.vectors.cols()},
                                                          {"/basis/vectors", basis.vectors.cols()}};
-  if (s.basisFrom.empty()) fields.insert(fields.begin() + 1, {"/derivatives/vectors", s.modes * (s.modes + 1) / 2});
+  if (s.basisFrom.empty() && s.basisKind != BasisKind::Modes)
+    fields.insert(fields.begin() + 1, {"/derivatives/vectors", s.modes * (s.modes + 1) / 2});
   ctx.onRankZero([&] { writeModesXdmf(s.output + ".xmf", h5Name, mesh.mesh.vertexCount(), mesh.mesh.tetCount(), fields); });
   archive.close();
   ctx.onRankZero([&] { fs::rename(partialPath, finalPath); });

@@ -10,6 +10,7 @@
 #include "common/fixed_vertices.h"
 #include "common/mesh_checks.h"
 #include "precompute/bake_context.h"
+#include "precompute/stages/basis.h"
 #include "formats/model_contents.h"
 
 namespace quiver {
@@ -22,6 +23,8 @@ struct BakeSettings {
   Material fallback;           // where neither the file nor the command line gives one
   int modes = 20;              // k, linear modes
   int rank = 30;               // r, basis vectors
+  BasisKind basisKind = BasisKind::Pca;  // the recipe from modes and derivatives (precompute/stages/basis.h)
+  bool exactRank = false;      // fail rather than bake fewer than `rank` vectors when the recipe gives fewer
   std::string basisFrom;       // user basis: FILE.npy (3N x r) or FILE.h5:/dataset; "" for none
   bool exportNpy = false;      // also write NAME.eigenvalues.npy, NAME.modes.npy, NAME.U.npy
   ExportSettings model;        // how NAME.qvr stores the basis, default damping and time step

@@ -1,5 +1,6 @@
 #include "precompute/stages/basis.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -31,34 +32,110 @@ double massOrthonormalize(Mat mass, const DofLayout& layout, Eigen::MatrixXd& U)
   return orthonormalityError(mass, layout, U);
 }
 
-ReducedBasis buildBasis(Mat mass, const DofLayout& layout, const LinearModes& modes,
-                        const ModalDerivatives& derivatives, const BasisSettings& settings) {
+const char* basisKindName(BasisKind kind) {
+  switch (kind) {
+    case BasisKind::Pca: return "pca";
+    case BasisKind::KeepModes: return "keep-modes";
+    case BasisKind::Modes: return "modes";
+  }
+  return "?";
+}
+
+namespace {
+
+// The weight Barbič & James give derivative (i, j), sqrt 2 for the pair it stands for twice.
+double derivativeWeight(const LinearModes& modes, int i, int j) {
+  const double l1 = modes.eigenvalues[0];
+  return (i == j ? 1.0 : std::sqrt(2.0)) * l1 * l1 / (modes.eigenvalues[i] * modes.eigenvalues[j]);
+}
+
+// Fewer vectors than asked: the largest basis the recipe gives, with a warning, or an error.
+int achievableRank(int wanted, int available, const BasisSettings& settings, const std::string& why,
+                   std::string& warning) {
+  if (available >= wanted) return wanted;
+  const std::string text = "basis (" + std::string(basisKindName(settings.kind)) + "): " + why + "; r = " +
+                           std::to_string(available) + " instead of " + std::to_string(wanted);
+  if (settings.exactRank || available < 1) throw std::runtime_error(text + " (--exact-rank: refused)");
+  warning = text;
+  return available;
+}
+
+// Mass-PCA through the small Gram matrix A^T M A = V D V^T: U = A V_r D_r^{-1/2}.
+Eigen::MatrixXd massPca(Mat mass, const DofLayout& layout, const LinearModes& modes,
+                        const ModalDerivatives& derivatives, const BasisSettings& settings, ReducedBasis& out) {
   const int k = static_cast<int>(modes.eigenvalues.size());
   const int m = k + static_cast<int>(derivatives.pairs.size());
-  if (settings.rank < 1 || settings.rank > m)
-    throw std::runtime_error("basis rank r = " + std::to_string(settings.rank) + " must lie in [1, " +
-                             std::to_string(m) + "] (k modes + k(k+1)/2 derivatives)");
   const double l1 = modes.eigenvalues[0];
   Eigen::MatrixXd A(layout.localDofs(), m);
   for (int i = 0; i < k; ++i) A.col(i) = modes.vectors.col(i) * (l1 / modes.eigenvalues[i]);
   for (size_t p = 0; p < derivatives.pairs.size(); ++p) {
     const auto [i, j] = derivatives.pairs[p];
-    const double weight = (i == j ? 1.0 : std::sqrt(2.0)) * l1 * l1 / (modes.eigenvalues[i] * modes.eigenvalues[j]);
-    A.col(k + static_cast<Eigen::Index>(p)) = derivatives.vectors.col(static_cast<Eigen::Index>(p)) * weight;
+    A.col(k + static_cast<Eigen::Index>(p)) = derivatives.vectors.col(static_cast<Eigen::Index>(p)) * derivativeWeight(modes, i, j);
   }
-  // Mass-PCA through the small Gram matrix A^T M A = V D V^T: U = A V_r D_r^{-1/2}.
   const Eigen::MatrixXd gram = innerProducts(A, multiply(mass, A, layout), layout.comm());
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(gram);
   if (eig.info() != Eigen::Success) throw std::runtime_error("mass-PCA: the eigen-decomposition failed");
-  ReducedBasis out;
   for (int i = m - 1; i >= 0; --i) out.singularValues.push_back(std::sqrt(std::max(eig.eigenvalues()[i], 0.0)));
-  const int r = settings.rank;
-  if (!(out.singularValues[r - 1] > 1e-7 * out.singularValues[0]))
-    throw std::runtime_error("mass-PCA: only " + std::to_string(r - 1) +
-                             " independent directions above 1e-7 of the largest; ask for a smaller --rank");
+  int resolved = 0;
+  while (resolved < m && out.singularValues[resolved] > 1e-7 * out.singularValues[0]) ++resolved;
+  const int r = achievableRank(settings.rank, resolved, settings,
+                               "only " + std::to_string(resolved) + " independent directions above 1e-7 of the largest",
+                               out.warning);
   Eigen::MatrixXd V = eig.eigenvectors().rightCols(r).rowwise().reverse();
   for (int i = 0; i < r; ++i) V.col(i) /= out.singularValues[i];
-  out.vectors = A * V;
+  return A * V;
+}
+
+// The modes, then derivatives by weight, each M-orthogonalised against the basis so far (twice,
+// for the digits) and kept while what is left of it is above 1e-6 of its M-norm.
+Eigen::MatrixXd modesThenDerivatives(Mat mass, const DofLayout& layout, const LinearModes& modes,
+                                     const ModalDerivatives& derivatives, const BasisSettings& settings,
+                                     std::string& warning) {
+  const int k = static_cast<int>(modes.eigenvalues.size());
+  const int first = std::min(k, settings.rank);
+  Eigen::MatrixXd U = modes.vectors.leftCols(first);
+  std::vector<size_t> order(derivatives.pairs.size());
+  for (size_t p = 0; p < order.size(); ++p) order[p] = p;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return derivativeWeight(modes, derivatives.pairs[a][0], derivatives.pairs[a][1]) >
+           derivativeWeight(modes, derivatives.pairs[b][0], derivatives.pairs[b][1]);
+  });
+  for (size_t p : order) {
+    if (U.cols() >= settings.rank) break;
+    Eigen::VectorXd x = derivatives.vectors.col(static_cast<Eigen::Index>(p));
+    const double size = std::sqrt(innerProducts(x, multiply(mass, x, layout), layout.comm())(0, 0));
+    if (!(size > 0)) continue;
+    x /= size;
+    for (int pass = 0; pass < 2; ++pass) x -= U * innerProducts(U, multiply(mass, x, layout), layout.comm());
+    const double left = std::sqrt(innerProducts(x, multiply(mass, x, layout), layout.comm())(0, 0));
+    if (!(left > 1e-6)) continue;
+    U.conservativeResize(Eigen::NoChange, U.cols() + 1);
+    U.col(U.cols() - 1) = x / left;
+  }
+  achievableRank(settings.rank, static_cast<int>(U.cols()), settings,
+                 "the " + std::to_string(k) + " modes and their derivatives give only " + std::to_string(U.cols()) +
+                     " independent directions",
+                 warning);
+  return U;
+}
+
+} // namespace
+
+ReducedBasis buildBasis(Mat mass, const DofLayout& layout, const LinearModes& modes,
+                        const ModalDerivatives& derivatives, const BasisSettings& settings) {
+  if (settings.rank < 1) throw std::runtime_error("basis rank r must be at least 1");
+  ReducedBasis out;
+  const int k = static_cast<int>(modes.eigenvalues.size());
+  switch (settings.kind) {
+    case BasisKind::Pca: out.vectors = massPca(mass, layout, modes, derivatives, settings, out); break;
+    case BasisKind::KeepModes:
+      out.vectors = modesThenDerivatives(mass, layout, modes, derivatives, settings, out.warning);
+      break;
+    case BasisKind::Modes:
+      out.vectors = modes.vectors.leftCols(
+          achievableRank(settings.rank, k, settings, "only " + std::to_string(k) + " modes were baked", out.warning));
+      break;
+  }
   out.orthonormalityError = massOrthonormalize(mass, layout, out.vectors);
   layout.orientColumns(out.vectors);
   if (!(out.orthonormalityError <= settings.maxOrthonormalityError))

@@ -1,11 +1,23 @@
 #pragma once
-// Stage "basis": the reduced basis U (free DOFs x r), M-orthonormal (U^T M U = I).
-// From the bake's own vectors: linear modes scaled by lambda_1 / lambda_i and modal derivatives
-// scaled by lambda_1^2 / (lambda_i lambda_j) (Barbič & James 2005), then mass-PCA: the r dominant
-// directions of that set in the M inner product. Derivatives with i != j carry an extra sqrt(2):
-// Psi_ij stands for both Psi_ij and Psi_ji, and with that weight the basis no longer depends on
-// how an eigensolver picks vectors inside a repeated eigenvalue's eigenspace.
-// Or from the user (--basis-from): any full-rank set of columns, M-orthonormalised.
+// Stage "basis": the reduced basis U (free DOFs x r), M-orthonormal (U^T M U = I). Three recipes
+// from the bake's own vectors (--basis), or the user's (--basis-from):
+// - pca (default; Barbič & James 2005): linear modes scaled by lambda_1 / lambda_i and modal
+//   derivatives scaled by lambda_1^2 / (lambda_i lambda_j), then mass-PCA: the r dominant
+//   directions of that set in the M inner product. Derivatives with i != j carry an extra sqrt(2):
+//   Psi_ij stands for both Psi_ij and Psi_ji, and with that weight the basis no longer depends on
+//   how an eigensolver picks vectors inside a repeated eigenvalue's eigenspace. Buys: the best
+//   r-dimensional fit to the weighted set, so large bending; but it may drop higher modes (the
+//   weights rank their derivatives' bending above them), and where the spectrum spans many
+//   decades the weights fall below what the mass-PCA can resolve (1e-7 of the largest).
+// - keep-modes: the k modes exactly, then the derivatives in the order of those weights, each
+//   M-orthogonalised against what is already in and kept while it adds a direction (1e-6 of its
+//   own norm). Buys: every baked frequency reproduced exactly (twist included), and independence
+//   judged per vector, so spectra spread over any range are fine.
+// - modes: the first r modes. Buys: linear modal accuracy and the cheapest bake (no
+//   derivatives); large deformations stay linear-looking.
+// When the recipe yields fewer independent vectors than r, the basis has as many as it yields and
+// says so in `warning` (or, with exactRank, the stage fails).
+#include <string>
 #include <string>
 #include <vector>
 
@@ -18,8 +30,14 @@
 
 namespace quiver {
 
+enum class BasisKind { Pca, KeepModes, Modes };
+// "pca", "keep-modes", "modes"; the recipe's name in messages and the archive.
+const char* basisKindName(BasisKind kind);
+
 struct BasisSettings {
-  int rank = 30;                          // r, basis vectors kept (>= 1)
+  int rank = 30;                          // r, basis vectors wanted (>= 1)
+  BasisKind kind = BasisKind::Pca;
+  bool exactRank = false;                 // fail rather than bake fewer than r vectors
   double maxOrthonormalityError = 1e-10;  // refuse a basis with max |U^T M U - I| above this
 };
 
@@ -27,9 +45,11 @@ struct ReducedBasis {
   Eigen::MatrixXd vectors;               // this rank's rows, r columns, M-orthonormal, oriented
   std::vector<double> singularValues;    // mass-PCA singular values, descending (all of them)
   double orthonormalityError = 0;        // max |U^T M U - I|
+  std::string warning;                   // why r is smaller than asked, or ""
 };
 
-// Collective. Throws when the scaled set has fewer than r independent directions.
+// Collective. `derivatives` may be empty for BasisKind::Modes. Throws when the recipe yields fewer
+// than r vectors and settings.exactRank is set.
 ReducedBasis buildBasis(Mat mass, const DofLayout& layout, const LinearModes& modes,
                         const ModalDerivatives& derivatives, const BasisSettings& settings);
 

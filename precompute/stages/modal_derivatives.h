@@ -19,7 +19,7 @@
 namespace quiver {
 
 struct DerivativeSettings {
-  double maxResidual = 1e-8;  // refuse solutions with ||K Psi - b|| / ||b|| above this
+  double maxResidual = 1e-10;  // refuse solutions with ||K Psi - b|| / (||K||_1 ||Psi|| + ||b||) above this
   int blockSize = 32;         // right-hand sides per solve call, so that progress can be reported
   ProgressCallback progress;  // (solved, total); optional
 };
@@ -27,7 +27,7 @@ struct DerivativeSettings {
 struct ModalDerivatives {
   std::vector<std::array<int, 2>> pairs;  // (i, j), i <= j, in order (0,0), (0,1), ..., (k-1,k-1)
   Eigen::MatrixXd vectors;                // this rank's rows, one column per pair
-  std::vector<double> residuals;          // ||K Psi - b|| / ||b|| per pair
+  std::vector<double> residuals;          // ||K Psi - b|| / (||K||_1 ||Psi|| + ||b||) per pair
 };
 
 // Collective. `tetPart` says which tets this rank integrates; `rigid` is rigidModes() on a free

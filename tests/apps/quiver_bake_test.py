@@ -104,7 +104,8 @@ class QuiverBake(unittest.TestCase):
             (["--E", "-1"], "Young's modulus"),
             (["--fix", "x<-5"], "selects no vertex"),
             (["--fix", "q<1"], "expected x, y or z"),
-            (["--modes", "3", "--rank", "10"], "--rank 10 exceeds the 9 vectors"),
+            (["--modes", "3", "--rank", "10", "--exact-rank"], "--rank 10 exceeds the 9 vectors"),
+            (["--modes", "3", "--rank", "4", "--basis", "modes", "--exact-rank"], "--rank 4 exceeds the 3 vectors"),
             (["--fix", "x>-1", "--modes", "2", "--rank", "3"], "free DOFs"),
             (["--basis-from", os.path.join(self.dir, "none.npy")], "none.npy"),
             (["--basis-from", os.path.join(self.dir, "beam1.h5:/nothing")], "/nothing"),
@@ -117,6 +118,14 @@ class QuiverBake(unittest.TestCase):
                     self.assertIn(message, p.stderr)
                     self.assertEqual(p.stderr.count("quiver-bake: error:"), 1, p.stderr)
                     self.assertFalse(os.path.exists(os.path.join(self.dir, "bad.h5")))
+
+    def test_more_vectors_than_the_recipe_gives_warn_and_bake_the_largest_r(self):
+        p = bake(1, self.beam, "--modes", "3", "--rank", "10", "-o", os.path.join(self.dir, "fewer"))
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("r = 9 instead of 10", p.stderr)
+        p = bake(1, self.beam, "--basis", "svd", "-o", os.path.join(self.dir, "fewer"))
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn("svd not in {pca,keep-modes,modes}", p.stderr)
 
     def test_missing_mesh_is_named(self):
         p = bake(2, os.path.join(self.dir, "none.msh"), "-o", os.path.join(self.dir, "b"))

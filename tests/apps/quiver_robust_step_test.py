@@ -5,7 +5,12 @@ degrees) and a beam whose vertices the test jitters into slivers. Each is baked 
 over 8% of its length, E = 1 MPa, nu = 0.4, 20 modes, r = 30), then dragged sideways by half and by the
 whole length, twisted by 60 and 180 degrees with stiff springs (1e5 N/m per vertex) at 120 Hz, pulled
 under gravity at 1/30 s steps, and let go at once. No step may reset, and after the release, with no
-damping, kinetic + elastic energy may never exceed what it was at the release."""
+damping, kinetic + elastic energy may never exceed what it was at the release.
+
+And the bake on a spectrum spread over decades (slender beams whose 20 modes span 250x in frequency,
+6e4 in eigenvalue): every basis recipe bakes, more vectors than the recipe yields give a warning
+and the largest r (or, with --exact-rank, a clear error), keep-modes reproduces every baked
+frequency exactly, and the result steps through a hard drag without a reset."""
 import csv
 import json
 import os
@@ -136,6 +141,64 @@ class RobustStep(unittest.TestCase):
                           f"{after.max():.4g} J, drift over {len(after)} steps {(after[-1] - released) / released:+.2%}")
                     self.assertGreater(released, 0)
                     self.assertLessEqual(after.max(), released * (1 + 1e-5))  # the CSV prints 6 digits
+
+
+class SpreadSpectrum(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.beams = {}
+        for length in (20, 30):
+            path = os.path.join(cls.tmp.name, f"slender{length}.vtu")
+            run(MESH, "beam", "--size", f"{length},0.1,0.1", "--cells", f"{10 * length},1,1", "-o", path)
+            cls.beams[length] = path
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def bake(self, length, *args, codes=(0,)):
+        out = os.path.join(self.tmp.name, f"b{length}")
+        p = run(MPIEXEC, "-n", "2", "--oversubscribe", BAKE, self.beams[length], "--fix", f"x<min+{0.08 * length}",
+                "--E", "1e6", "--nu", "0.4", "--density", "1000", "--modes", "20", "--quiet", "-o", out, *args,
+                codes=codes)
+        return out, p
+
+    def test_every_recipe_bakes_and_says_when_r_is_smaller(self):
+        for length in (20, 30):
+            for kind, rank, expect in (("pca", 30, 30), ("keep-modes", 60, 60), ("modes", 30, 20)):
+                with self.subTest(length=length, basis=kind, rank=rank):
+                    out, p = self.bake(length, "--basis", kind, "--rank", rank)
+                    info = json.loads(run(QUIVER, "info", out + ".qvr").stdout)
+                    hz = np.array(info["frequencies_hz"])
+                    self.assertGreater(hz[-1] / hz[0], 200, "the spectrum must be spread")
+                    self.assertEqual(info["r"], expect)
+                    self.assertEqual("warning" in p.stderr, expect < rank, p.stderr)
+            # More than the mass-PCA can resolve: a warning and the largest r, or with --exact-rank an error.
+            out, p = self.bake(length, "--basis", "pca", "--rank", 60)
+            info = json.loads(run(QUIVER, "info", out + ".qvr").stdout)
+            self.assertLess(info["r"], 60)
+            self.assertIn(f"r = {info['r']} instead of 60", p.stderr)
+            _, p = self.bake(length, "--basis", "pca", "--rank", 60, "--exact-rank", codes=(1,))
+            self.assertIn("--exact-rank", p.stderr)
+            self.assertEqual(p.stderr.count("error"), 1, p.stderr)  # one message, not one per rank
+
+    def test_keep_modes_reproduces_every_baked_frequency(self):
+        out, _ = self.bake(30, "--basis", "keep-modes", "--rank", 40)
+        info = json.loads(run(QUIVER, "info", out + ".qvr").stdout)
+        baked, reduced = np.array(info["frequencies_hz"]), np.sort(info["reduced_frequencies_hz"])[:20]
+        np.testing.assert_allclose(reduced, baked, rtol=1e-6)
+        pca, _ = self.bake(30, "--basis", "pca", "--rank", 30)
+        info = json.loads(run(QUIVER, "info", pca + ".qvr").stdout)
+        worst = np.max(np.abs(np.sort(info["reduced_frequencies_hz"])[:20] / baked - 1))
+        print(f"slender beam, 20 modes spanning {baked[-1] / baked[0]:.0f}x: keep-modes holds them to 1e-6, "
+              f"pca (r = 30) to {worst:.1%}")
+
+    def test_the_spread_model_steps_through_a_hard_drag(self):
+        out, _ = self.bake(30, "--basis", "keep-modes", "--rank", 40)
+        p = run(QUIVER, "sim", out + ".qvr", "--group", "x>max-2.4", "--drag", "0,15,0", "--stiffness", 1e4,
+                "--hold", 120, "--steps", 240, "--dt", 1 / 60, "--json")
+        self.assertEqual(json.loads(p.stdout)["resets"], 0)
 
 
 if __name__ == "__main__":
