@@ -22,12 +22,12 @@ int main(int argc, char** argv) {
   bool quiet = false;
   meshOptions.addTo(app);
   fixedOptions.addTo(app);
-  app.add_option("--E", s.material.youngsModulus, "Young's modulus in Pa (> 0); overrides the mesh file's materials");
-  app.add_option("--nu", s.material.poissonRatio, "Poisson ratio in (-1, 0.5); overrides the mesh file's materials");
-  app.add_option("--density", s.material.density, "Density in kg/m^3 (> 0); overrides the mesh file's materials");
+  app.add_option("--E", s.mesh.material.youngsModulus, "Young's modulus in Pa (> 0); overrides the mesh file's materials");
+  app.add_option("--nu", s.mesh.material.poissonRatio, "Poisson ratio in (-1, 0.5); overrides the mesh file's materials");
+  app.add_option("--density", s.mesh.material.density, "Density in kg/m^3 (> 0); overrides the mesh file's materials");
   app.add_option("--modes", s.modes, "Linear modes k (the six rigid modes of a free object are not counted)")
       ->capture_default_str();
-  app.add_option("--rank", s.rank, "Basis vectors r, at most the free DOFs; fewer (with a warning) where --basis yields fewer")
+  app.add_option("--rank", s.basis.settings.rank, "Basis vectors r, at most the free DOFs; fewer (with a warning) where --basis yields fewer")
       ->capture_default_str();
   std::vector<std::string> kinds;
   for (BasisKind kind : {BasisKind::Pca, BasisKind::KeepModes, BasisKind::Modes}) kinds.push_back(basisKindName(kind));
@@ -35,25 +35,25 @@ int main(int argc, char** argv) {
          "--basis",
          [&s](const std::string& name) {
            for (BasisKind kind : {BasisKind::Pca, BasisKind::KeepModes, BasisKind::Modes})
-             if (name == basisKindName(kind)) s.basisKind = kind;
+             if (name == basisKindName(kind)) s.basis.settings.kind = kind;
          },
          "pca: mass-PCA of the weighted modes and derivatives (Barbic & James); keep-modes: the k modes exactly, then "
          "derivatives; modes: the first r modes (precompute/stages/basis.h says what each buys)")
       ->check(CLI::IsMember(kinds))
       ->default_str("pca");
-  app.add_flag("--exact-rank", s.exactRank, "Fail rather than bake fewer than --rank vectors");
-  app.add_option("--basis-from", s.basisFrom,
+  app.add_flag("--exact-rank", s.basis.settings.exactRank, "Fail rather than bake fewer than --rank vectors");
+  app.add_option("--basis-from", s.basis.userBasis,
                  "Use this basis instead of modes + derivatives: FILE.npy or FILE.h5:/dataset, shape (3 x vertices, r) "
                  "in the mesh file's vertex order");
-  app.add_option("--basis-precision", s.model.basisPrecision, "Bits per basis entry in NAME.qvr: 32 or 64")
+  app.add_option("--basis-precision", s.output.model.basisPrecision, "Bits per basis entry in NAME.qvr: 32 or 64")
       ->capture_default_str();
-  app.add_option("--damping-ratio", s.model.dampingRatio,
+  app.add_option("--damping-ratio", s.output.model.dampingRatio,
                  "Default damping stored in NAME.qvr: fraction of critical at the first mode (stiffness-proportional)")
       ->capture_default_str();
-  app.add_option("--time-step", s.model.timeStep, "Suggested time step stored in NAME.qvr, in s")->capture_default_str();
-  app.add_flag("--export-npy", s.exportNpy, "Also write NAME.eigenvalues.npy, NAME.modes.npy and NAME.U.npy (float64)");
+  app.add_option("--time-step", s.output.model.timeStep, "Suggested time step stored in NAME.qvr, in s")->capture_default_str();
+  app.add_flag("--export-npy", s.output.exportNpy, "Also write NAME.eigenvalues.npy, NAME.modes.npy and NAME.U.npy (float64)");
   app.add_flag("--resume", s.resume, "Reuse the stages of NAME.h5.partial (or NAME.h5) whose inputs have not changed");
-  app.add_option("-o,--output", s.output, "Output name: writes NAME.qvr, NAME.h5 and NAME.xmf")->required();
+  app.add_option("-o,--output", s.output.name, "Output name: writes NAME.qvr, NAME.h5 and NAME.xmf")->required();
   app.add_flag("--quiet", quiet, "Print nothing but warnings and errors");
 
   std::vector<char*> ownArgv;
@@ -65,15 +65,15 @@ int main(int argc, char** argv) {
   }
   for (int i = 0; i < argc; ++i) s.commandLine += (i ? " " : "") + std::string(argv[i]);
   for (size_t i = 1; i < petsc.size(); ++i) s.petscOptions += (i > 1 ? " " : "") + petsc[i];
-  s.meshPath = meshOptions.path;
-  s.checks = meshOptions.checks;
+  s.mesh.path = meshOptions.path;
+  s.mesh.checks = meshOptions.checks;
 
   BakeContext ctx(petsc);
   ctx.quiet = quiet;
   std::string error;
   try {
     checkBakeSettings(s);  // before any work
-    s.fixed = fixedOptions.resolved();
+    s.mesh.fixed = fixedOptions.resolved();
     runBake(ctx, s);
   } catch (const std::exception& e) {
     error = e.what();

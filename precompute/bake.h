@@ -6,33 +6,25 @@
 #include <string>
 #include <vector>
 
-#include "common/tet_mesh.h"
-#include "common/fixed_vertices.h"
-#include "common/mesh_checks.h"
 #include "precompute/bake_context.h"
 #include "precompute/stages/basis.h"
-#include "formats/model_contents.h"
+#include "precompute/stages/export_model.h"
+#include "precompute/stages/mesh.h"
 
 namespace quiver {
 
 struct BakeSettings {
-  std::string meshPath;
-  MeshCheckOptions checks;
-  FixedVertexRequest fixed;
-  MaterialOverride material;   // explicit values win over the mesh file's
-  Material fallback;           // where neither the file nor the command line gives one
+  MeshSettings mesh;           // the mesh, its checks, fixed vertices and materials (stages/mesh.h)
   int modes = 20;              // k, linear modes
-  int rank = 30;               // r, basis vectors
-  BasisKind basisKind = BasisKind::Pca;  // the recipe from modes and derivatives (precompute/stages/basis.h)
-  bool exactRank = false;      // fail rather than bake fewer than `rank` vectors when the recipe gives fewer
-  std::string basisFrom;       // user basis: FILE.npy (3N x r) or FILE.h5:/dataset; "" for none
-  bool exportNpy = false;      // also write NAME.eigenvalues.npy, NAME.modes.npy, NAME.U.npy
-  ExportSettings model;        // how NAME.qvr stores the basis, default damping and time step
+  BasisRequest basis;          // r and the recipe, or a user basis (stages/basis.h)
+  ExportRequest output;        // NAME, how NAME.qvr stores the model, the .npy exports (stages/export_model.h)
   bool resume = false;         // reuse stages of NAME.h5.partial / NAME.h5 whose inputs hash the same
-  std::string output;          // NAME
   std::string commandLine;     // for provenance
   std::string petscOptions;    // the PETSc/SLEPc options given, part of the modes' input hash
 };
+
+// The version the archive records: the CMake project's, which the runtime's QV_VERSION_* match.
+const char* bakeVersion();
 
 // Checks that need no mesh: ranges of k, r and material values. Throws std::invalid_argument.
 void checkBakeSettings(const BakeSettings& settings);

@@ -5,8 +5,8 @@
 namespace quiver {
 
 namespace {
-
 const char* kHash = "input_hash";
+} // namespace
 
 void writeVector(Archive& archive, const std::string& dataset, const std::vector<double>& values) {
   archive.writeReplicated(dataset, {static_cast<int64_t>(values.size())}, values.data());
@@ -17,7 +17,6 @@ std::vector<double> readVector(const Archive& archive, const std::string& datase
   return archive.readReplicatedDouble(dataset, shape);
 }
 
-// Starts a stage group afresh: whatever a killed run left there goes first.
 void resetGroup(Archive& archive, const std::string& group) {
   if (archive.exists(group)) archive.removeObject(group);
   archive.createGroup(group);
@@ -27,8 +26,6 @@ void finishGroup(Archive& archive, const std::string& group, const std::string& 
   archive.setAttribute(group, kHash, inputHash);
   archive.flush();
 }
-
-} // namespace
 
 std::string storedInputHash(const Archive& archive, const std::string& group) {
   if (!archive.exists(group) || !archive.hasAttribute(group, kHash)) return "";
@@ -93,81 +90,6 @@ void writeInputs(Archive& archive, const CheckedMesh& mesh, const std::string& s
   archive.writeReplicated("/partition/vertex_part", {n}, partition.vertexPart.data());
   archive.setAttribute("/partition", "ranks", static_cast<int64_t>(ranks));
   archive.flush();
-}
-
-void writeModes(Archive& archive, const LinearModes& modes, const DofLayout& layout, const std::string& inputHash) {
-  resetGroup(archive, "/modes");
-  writeVector(archive, "/modes/eigenvalues", modes.eigenvalues);
-  writeVector(archive, "/modes/frequencies_hz", modes.frequenciesHz());
-  writeVector(archive, "/modes/residuals", modes.residuals);
-  writeVectors(archive, "/modes/vectors", modes.vectors, layout);
-  archive.setAttribute("/modes", "rigid_modes_skipped", static_cast<int64_t>(modes.rigidSkipped));
-  archive.setAttribute("/modes", "shift", modes.shift);
-  finishGroup(archive, "/modes", inputHash);
-}
-
-LinearModes readModes(const Archive& archive, const DofLayout& layout) {
-  LinearModes modes;
-  modes.eigenvalues = readVector(archive, "/modes/eigenvalues");
-  modes.residuals = readVector(archive, "/modes/residuals");
-  modes.vectors = readVectors(archive, "/modes/vectors", layout);
-  modes.rigidSkipped = static_cast<int>(archive.intAttribute("/modes", "rigid_modes_skipped"));
-  modes.shift = archive.doubleAttribute("/modes", "shift");
-  return modes;
-}
-
-void writeDerivatives(Archive& archive, const ModalDerivatives& derivatives, const DofLayout& layout,
-                      const std::string& inputHash) {
-  resetGroup(archive, "/derivatives");
-  std::vector<int32_t> pairs;
-  for (const auto& p : derivatives.pairs) pairs.insert(pairs.end(), {p[0], p[1]});
-  archive.writeReplicated("/derivatives/pairs", {static_cast<int64_t>(derivatives.pairs.size()), 2}, pairs.data());
-  writeVector(archive, "/derivatives/residuals", derivatives.residuals);
-  writeVectors(archive, "/derivatives/vectors", derivatives.vectors, layout);
-  finishGroup(archive, "/derivatives", inputHash);
-}
-
-ModalDerivatives readDerivatives(const Archive& archive, const DofLayout& layout) {
-  ModalDerivatives d;
-  std::vector<int64_t> shape;
-  const std::vector<int64_t> pairs = archive.readReplicatedInt("/derivatives/pairs", shape);
-  for (size_t p = 0; p + 1 < pairs.size(); p += 2)
-    d.pairs.push_back({static_cast<int>(pairs[p]), static_cast<int>(pairs[p + 1])});
-  d.residuals = readVector(archive, "/derivatives/residuals");
-  d.vectors = readVectors(archive, "/derivatives/vectors", layout);
-  return d;
-}
-
-void writeBasis(Archive& archive, const ReducedBasis& basis, const std::string& source, const DofLayout& layout,
-                const std::string& inputHash) {
-  resetGroup(archive, "/basis");
-  writeVectors(archive, "/basis/vectors", basis.vectors, layout);
-  writeVector(archive, "/basis/singular_values", basis.singularValues);
-  archive.setAttribute("/basis", "source", source);
-  archive.setAttribute("/basis", "orthonormality_error", basis.orthonormalityError);
-  finishGroup(archive, "/basis", inputHash);
-}
-
-ReducedBasis readBasis(const Archive& archive, const DofLayout& layout) {
-  ReducedBasis b;
-  b.vectors = readVectors(archive, "/basis/vectors", layout);
-  b.singularValues = readVector(archive, "/basis/singular_values");
-  b.orthonormalityError = archive.doubleAttribute("/basis", "orthonormality_error");
-  return b;
-}
-
-void writePolynomial(Archive& archive, const EnergyPolynomial& energy, const std::string& inputHash) {
-  resetGroup(archive, "/polynomials");
-  writeVector(archive, "/polynomials/energy_coefficients", energy.coefficients);
-  archive.setAttribute("/polynomials", "r", static_cast<int64_t>(energy.r));
-  finishGroup(archive, "/polynomials", inputHash);
-}
-
-EnergyPolynomial readPolynomial(const Archive& archive) {
-  EnergyPolynomial energy;
-  energy.r = static_cast<int>(archive.intAttribute("/polynomials", "r"));
-  energy.coefficients = readVector(archive, "/polynomials/energy_coefficients");
-  return energy;
 }
 
 } // namespace quiver

@@ -4,12 +4,20 @@
 // print nothing extra. Stages report through a plain callback so that they need no context.
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <string>
 
 #include "precompute/bake_context.h"
 
 namespace quiver {
+
+// A number in a progress line: three significant digits ("0.00324", "1.39e+03").
+inline std::string shortNumber(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", v);
+  return text;
+}
 
 // (done, total): called by a stage as work completes; may be empty.
 using ProgressCallback = std::function<void(int64_t done, int64_t total)>;

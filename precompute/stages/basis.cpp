@@ -2,11 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
+#include "formats/npy.h"
+#include "precompute/checkpoint.h"
+#include "precompute/input_hash.h"
 #include "precompute/distributed_dense.h"
 
 namespace quiver {
@@ -150,6 +154,93 @@ ReducedBasis importBasis(Mat mass, const DofLayout& layout, Eigen::MatrixXd rows
   out.vectors = std::move(rows);
   out.orthonormalityError = massOrthonormalize(mass, layout, out.vectors);
   return out;
+}
+
+void writeBasis(Archive& archive, const ReducedBasis& basis, const std::string& source, const DofLayout& layout,
+                const std::string& inputHash) {
+  resetGroup(archive, "/basis");
+  writeVectors(archive, "/basis/vectors", basis.vectors, layout);
+  writeVector(archive, "/basis/singular_values", basis.singularValues);
+  archive.setAttribute("/basis", "source", source);
+  archive.setAttribute("/basis", "orthonormality_error", basis.orthonormalityError);
+  finishGroup(archive, "/basis", inputHash);
+}
+
+ReducedBasis readBasis(const Archive& archive, const DofLayout& layout) {
+  ReducedBasis b;
+  b.vectors = readVectors(archive, "/basis/vectors", layout);
+  b.singularValues = readVector(archive, "/basis/singular_values");
+  b.orthonormalityError = archive.doubleAttribute("/basis", "orthonormality_error");
+  return b;
+}
+
+std::string basisInputHash(const std::string& vectorsHash, const BasisSettings& settings) {
+  return InputHash()
+      .add(vectorsHash)
+      .add(settings.rank)
+      .add(std::string(basisKindName(settings.kind)))
+      .add(settings.exactRank)
+      .add(std::string("basis 1"))
+      .hex();
+}
+
+std::string userBasisInputHash(const std::string& meshHash, const std::string& spec) {
+  return InputHash().add(meshHash).add(spec).add(std::string("user basis 1")).hex();
+}
+
+std::string describeBasis(const ReducedBasis& basis) {
+  return "r = " + std::to_string(basis.vectors.cols()) + ", max |U^T M U - I| = " + shortNumber(basis.orthonormalityError);
+}
+
+// The user basis as a full 3n x r matrix in the loaded mesh's vertex order.
+Eigen::MatrixXd loadUserBasis(MPI_Comm comm, const std::string& spec, const CheckedMesh& mesh) {
+  const int64_t fileRows = 3 * static_cast<int64_t>(mesh.loadedVertex.size());
+  std::vector<int64_t> shape;
+  std::vector<double> data;
+  const size_t colon = spec.find(".h5:");
+  if (colon != std::string::npos) {
+    Archive user(comm, spec.substr(0, colon + 3), Archive::Mode::ReadOnly);
+    data = user.readReplicatedDouble(spec.substr(colon + 4), shape);
+  } else {
+    NpyArray a = readNpy(spec);
+    shape = a.shape;
+    data = std::move(a.data);
+  }
+  // (3N, r) as numpy users write it, or (r, N, 3) as the archive stores vectors; N in file order.
+  const int64_t N = static_cast<int64_t>(mesh.loadedVertex.size());
+  const bool columns = shape.size() == 2 && shape[0] == fileRows;
+  const bool slices = shape.size() == 3 && shape[1] == N && shape[2] == 3;
+  if (!columns && !slices)
+    throw std::runtime_error(spec + ": a basis must have shape (3 x " + std::to_string(N) + " vertices, r) = (" +
+                             std::to_string(fileRows) + ", r), or (r, " + std::to_string(N) + ", 3)");
+  const int64_t r = columns ? shape[1] : shape[0];
+  Eigen::MatrixXd full(3 * static_cast<int64_t>(mesh.fileVertex.size()), r);
+  for (size_t v = 0; v < mesh.fileVertex.size(); ++v)
+    for (int c = 0; c < 3; ++c) {
+      const int64_t row = 3 * mesh.fileVertex[v] + c;
+      for (int64_t j = 0; j < r; ++j) full(3 * v + c, j) = columns ? data[row * r + j] : data[j * fileRows + row];
+    }
+  return full;
+}
+
+ReducedBasis bakeBasis(const BakeContext& ctx, const BasisRequest& request, const CheckedMesh& mesh, Mat mass,
+                       const DofLayout& layout, const LinearModes& modes, const ModalDerivatives& derivatives,
+                       Archive& archive, const std::string& inputHash) {
+  ReducedBasis basis;
+  std::string source;
+  if (request.userBasis.empty()) {
+    basis = buildBasis(mass, layout, modes, derivatives, request.settings);
+    source = request.settings.kind == BasisKind::Pca ? "modes+derivatives" : basisKindName(request.settings.kind);
+  } else {
+    bool wasOrthonormal = true;
+    basis = importBasis(mass, layout, layout.localRowsOf(loadUserBasis(ctx.comm(), request.userBasis, mesh)),
+                        wasOrthonormal);
+    if (!wasOrthonormal) basis.warning = request.userBasis + " was not M-orthonormal; it was orthonormalised";
+    source = request.userBasis;
+  }
+  if (!basis.warning.empty() && ctx.rank() == 0) std::fprintf(stderr, "quiver-bake: warning: %s\n", basis.warning.c_str());
+  writeBasis(archive, basis, source, layout, inputHash);
+  return basis;
 }
 
 } // namespace quiver

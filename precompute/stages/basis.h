@@ -18,12 +18,14 @@
 // When the recipe yields fewer independent vectors than r, the basis has as many as it yields and
 // says so in `warning` (or, with exactRank, the stage fails).
 #include <string>
-#include <string>
 #include <vector>
 
 #include <Eigen/Core>
 #include <petscmat.h>
 
+#include "common/mesh_checks.h"
+#include "precompute/archive/archive.h"
+#include "precompute/bake_context.h"
 #include "precompute/dof_layout.h"
 #include "precompute/stages/modal_derivatives.h"
 #include "precompute/stages/modes.h"
@@ -53,11 +55,38 @@ struct ReducedBasis {
 ReducedBasis buildBasis(Mat mass, const DofLayout& layout, const LinearModes& modes,
                         const ModalDerivatives& derivatives, const BasisSettings& settings);
 
+// The stage as the bake runs it: the recipe from the modes (and derivatives), or the user's basis
+// (`userBasis` not empty: FILE.npy or FILE.h5:/dataset), written to the archive's /basis. Rank 0
+// warns on stderr when r is smaller than asked or a user basis was not M-orthonormal.
+struct BasisRequest {
+  BasisSettings settings;
+  std::string userBasis;
+};
+ReducedBasis bakeBasis(const BakeContext& ctx, const BasisRequest& request, const CheckedMesh& mesh, Mat mass,
+                       const DofLayout& layout, const LinearModes& modes, const ModalDerivatives& derivatives,
+                       Archive& archive, const std::string& inputHash);
+
+// A user basis (--basis-from FILE.npy of shape (3N, r), or FILE.h5:/dataset of shape (r, N, 3), N
+// in the mesh file's vertex order) as a full 3n x r matrix in the loaded mesh's vertex order.
+// Collective. Throws naming the file and the shape it expected.
+Eigen::MatrixXd loadUserBasis(MPI_Comm comm, const std::string& spec, const CheckedMesh& mesh);
+
 // M-orthonormalises a user basis given as this rank's rows. `wasOrthonormal` reports whether
 // it already was (max |U^T M U - I| <= 1e-8). Throws when its columns are not independent.
 ReducedBasis importBasis(Mat mass, const DofLayout& layout, Eigen::MatrixXd rows, bool& wasOrthonormal);
 
 // U <- U L^{-T} with U^T M U = L L^T; returns max |U^T M U - I| afterwards. Collective.
 double massOrthonormalize(Mat mass, const DofLayout& layout, Eigen::MatrixXd& U);
+
+// Checkpoint: group /basis. Input hash: the derivatives' (the modes' for BasisKind::Modes), r, the
+// recipe and the stage's version tag; for a user basis, the mesh stage's and the basis's spec.
+std::string basisInputHash(const std::string& vectorsHash, const BasisSettings& settings);
+std::string userBasisInputHash(const std::string& meshHash, const std::string& spec);
+// `source`: the recipe's name or the user basis's spec.
+void writeBasis(Archive& archive, const ReducedBasis& basis, const std::string& source, const DofLayout& layout,
+                const std::string& inputHash);
+ReducedBasis readBasis(const Archive& archive, const DofLayout& layout);
+// Progress: "r = 30, max |U^T M U - I| = 6e-16".
+std::string describeBasis(const ReducedBasis& basis);
 
 } // namespace quiver

@@ -5,6 +5,8 @@
 #include <petscksp.h>
 
 #include "common/stvk_element.h"
+#include "precompute/checkpoint.h"
+#include "precompute/input_hash.h"
 #include "precompute/distributed_dense.h"
 
 namespace quiver {
@@ -156,6 +158,57 @@ ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<
                                std::to_string(out.residuals.back()) + ", above the limit");
   }
   return out;
+}
+
+void writeDerivatives(Archive& archive, const ModalDerivatives& derivatives, const DofLayout& layout,
+                      const std::string& inputHash) {
+  resetGroup(archive, "/derivatives");
+  std::vector<int32_t> pairs;
+  for (const auto& p : derivatives.pairs) pairs.insert(pairs.end(), {p[0], p[1]});
+  archive.writeReplicated("/derivatives/pairs", {static_cast<int64_t>(derivatives.pairs.size()), 2}, pairs.data());
+  writeVector(archive, "/derivatives/residuals", derivatives.residuals);
+  writeVectors(archive, "/derivatives/vectors", derivatives.vectors, layout);
+  finishGroup(archive, "/derivatives", inputHash);
+}
+
+ModalDerivatives readDerivatives(const Archive& archive, const DofLayout& layout) {
+  ModalDerivatives d;
+  std::vector<int64_t> shape;
+  const std::vector<int64_t> pairs = archive.readReplicatedInt("/derivatives/pairs", shape);
+  for (size_t p = 0; p + 1 < pairs.size(); p += 2)
+    d.pairs.push_back({static_cast<int>(pairs[p]), static_cast<int>(pairs[p + 1])});
+  d.residuals = readVector(archive, "/derivatives/residuals");
+  d.vectors = readVectors(archive, "/derivatives/vectors", layout);
+  return d;
+}
+
+std::string derivativesInputHash(const std::string& modesHash) {
+  // Version 2: residuals are normwise backward errors.
+  return InputHash().add(modesHash).add(std::string("derivatives 2")).hex();
+}
+
+std::string describeDerivatives(const ModalDerivatives& derivatives) {
+  return std::to_string(derivatives.pairs.size()) + " solved, max residual " +
+         shortNumber(*std::max_element(derivatives.residuals.begin(), derivatives.residuals.end()));
+}
+
+ModalDerivatives derivativesStage(StageRunner& stages, const BakeContext& ctx, const TetMesh& mesh,
+                                  const std::vector<Material>& perTet, const std::vector<int>& tetPart,
+                                  const AssembledSystem& system, const DofLayout& layout, const LinearModes& modes,
+                                  const Eigen::MatrixXd& rigid, const std::string& inputHash) {
+  bool reused = false;
+  const ModalDerivatives derivatives = stages.checkpointed(
+      "derivatives", "/derivatives", inputHash, [&](const Archive& a) { return readDerivatives(a, layout); },
+      [&] {
+        ProgressMeter meter(ctx, "derivatives", "solved");
+        DerivativeSettings settings;
+        settings.progress = meter.callback();
+        return computeModalDerivatives(mesh, perTet, tetPart, system.stiffness, system.mass, layout, modes, rigid,
+                                       settings);
+      },
+      [&](Archive& a, const ModalDerivatives& d, const std::string& h) { writeDerivatives(a, d, layout, h); }, reused);
+  stages.report(describeDerivatives(derivatives), reused);
+  return derivatives;
 }
 
 } // namespace quiver

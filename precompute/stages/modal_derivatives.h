@@ -6,12 +6,14 @@
 // On a free object K is singular: the right-hand sides are projected off the rigid modes, six
 // DOFs are pinned to pick one solution, and the result is made M-orthogonal to the rigid modes.
 #include <array>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
 #include <petscmat.h>
 
 #include "common/tet_mesh.h"
+#include "precompute/archive/archive.h"
 #include "precompute/dof_layout.h"
 #include "precompute/progress_meter.h"
 #include "precompute/stages/modes.h"
@@ -36,5 +38,19 @@ ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<
                                          const std::vector<int>& tetPart, Mat stiffness, Mat mass,
                                          const DofLayout& layout, const LinearModes& modes,
                                          const Eigen::MatrixXd& rigid, const DerivativeSettings& settings);
+
+// Checkpoint: group /derivatives. Input hash: the modes' and the stage's version tag.
+std::string derivativesInputHash(const std::string& modesHash);
+void writeDerivatives(Archive& archive, const ModalDerivatives& derivatives, const DofLayout& layout,
+                      const std::string& inputHash);
+ModalDerivatives readDerivatives(const Archive& archive, const DofLayout& layout);
+// Progress: "210 solved, max residual 4e-17".
+std::string describeDerivatives(const ModalDerivatives& derivatives);
+
+// The stage as the bake runs it: checkpointed under `inputHash`, with its progress line.
+ModalDerivatives derivativesStage(StageRunner& stages, const BakeContext& ctx, const TetMesh& mesh,
+                                  const std::vector<Material>& perTet, const std::vector<int>& tetPart,
+                                  const AssembledSystem& system, const DofLayout& layout, const LinearModes& modes,
+                                  const Eigen::MatrixXd& rigid, const std::string& inputHash);
 
 } // namespace quiver

@@ -7,6 +7,8 @@
 
 #include <slepceps.h>
 
+#include "precompute/checkpoint.h"
+#include "precompute/input_hash.h"
 #include "precompute/distributed_dense.h"
 
 namespace quiver {
@@ -175,6 +177,61 @@ LinearModes computeLinearModes(Mat stiffness, Mat mass, const DofLayout& layout,
       throw std::runtime_error(why.str());
     }
   return out;
+}
+
+void writeModes(Archive& archive, const LinearModes& modes, const DofLayout& layout, const std::string& inputHash) {
+  resetGroup(archive, "/modes");
+  writeVector(archive, "/modes/eigenvalues", modes.eigenvalues);
+  writeVector(archive, "/modes/frequencies_hz", modes.frequenciesHz());
+  writeVector(archive, "/modes/residuals", modes.residuals);
+  writeVectors(archive, "/modes/vectors", modes.vectors, layout);
+  archive.setAttribute("/modes", "rigid_modes_skipped", static_cast<int64_t>(modes.rigidSkipped));
+  archive.setAttribute("/modes", "shift", modes.shift);
+  finishGroup(archive, "/modes", inputHash);
+}
+
+LinearModes readModes(const Archive& archive, const DofLayout& layout) {
+  LinearModes modes;
+  modes.eigenvalues = readVector(archive, "/modes/eigenvalues");
+  modes.residuals = readVector(archive, "/modes/residuals");
+  modes.vectors = readVectors(archive, "/modes/vectors", layout);
+  modes.rigidSkipped = static_cast<int>(archive.intAttribute("/modes", "rigid_modes_skipped"));
+  modes.shift = archive.doubleAttribute("/modes", "shift");
+  return modes;
+}
+
+std::string modesInputHash(const std::string& meshHash, int count, const std::string& petscOptions) {
+  return InputHash().add(meshHash).add(count).add(petscOptions).add(std::string("modes 1")).hex();
+}
+
+std::vector<std::string> describeModes(const LinearModes& modes) {
+  const auto hz = modes.frequenciesHz();
+  std::vector<std::string> lines{std::to_string(hz.size()) + " modes, " + shortNumber(hz.front()) + " to " +
+                                 shortNumber(hz.back()) + " Hz, max residual " +
+                                 shortNumber(*std::max_element(modes.residuals.begin(), modes.residuals.end()))};
+  for (size_t i = 0; i < hz.size(); ++i)
+    lines.push_back("  mode " + std::to_string(i) + ": " + shortNumber(hz[i]) + " Hz (lambda " +
+                    shortNumber(modes.eigenvalues[i]) + "), residual " + shortNumber(modes.residuals[i]));
+  return lines;
+}
+
+LinearModes modesStage(StageRunner& stages, const BakeContext& ctx, const AssembledSystem& system,
+                       const DofLayout& layout, const Eigen::MatrixXd& rigid, int count, const std::string& inputHash) {
+  bool reused = false;
+  const LinearModes modes = stages.checkpointed(
+      "modes", "/modes", inputHash, [&](const Archive& a) { return readModes(a, layout); },
+      [&] {
+        ProgressMeter meter(ctx, "modes", "converged");
+        ModeSettings settings;
+        settings.count = count;
+        settings.progress = meter.callback();
+        return computeLinearModes(system.stiffness, system.mass, layout, settings, rigid);
+      },
+      [&](Archive& a, const LinearModes& m, const std::string& h) { writeModes(a, m, layout, h); }, reused);
+  const std::vector<std::string> lines = describeModes(modes);
+  stages.report(lines[0], reused);
+  for (size_t i = 1; i < lines.size(); ++i) ctx.progress(lines[i]);
+  return modes;
 }
 
 } // namespace quiver

@@ -6,13 +6,17 @@
 // eigenvalue, which a cheap first solve estimates; so K - sigma M is definite and as well
 // conditioned as on a clamped object.
 // The defaults can be overridden from the command line with SLEPc's own options (-eps_*, -st_*).
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
 #include <petscmat.h>
 
+#include "precompute/archive/archive.h"
 #include "precompute/dof_layout.h"
 #include "precompute/progress_meter.h"
+#include "precompute/stage_runner.h"
+#include "precompute/stages/assemble.h"
 
 namespace quiver {
 
@@ -43,5 +47,17 @@ LinearModes computeLinearModes(Mat stiffness, Mat mass, const DofLayout& layout,
 // ||K phi_i - lambda_i M phi_i|| / (||K||_1 ||phi_i||) for the columns of `vectors` (local rows).
 std::vector<double> eigenResiduals(Mat stiffness, Mat mass, const std::vector<double>& eigenvalues,
                                    const Eigen::MatrixXd& vectors, const DofLayout& layout);
+
+// Checkpoint: group /modes. Input hash: the mesh stage's, k, the PETSc/SLEPc options given, and the
+// stage's version tag.
+std::string modesInputHash(const std::string& meshHash, int count, const std::string& petscOptions);
+void writeModes(Archive& archive, const LinearModes& modes, const DofLayout& layout, const std::string& inputHash);
+LinearModes readModes(const Archive& archive, const DofLayout& layout);
+// Progress: "20 modes, 0.81 to 50 Hz, max residual 1e-16", then a line per mode.
+std::vector<std::string> describeModes(const LinearModes& modes);
+
+// The stage as the bake runs it: checkpointed under `inputHash`, with its progress lines.
+LinearModes modesStage(StageRunner& stages, const BakeContext& ctx, const AssembledSystem& system,
+                       const DofLayout& layout, const Eigen::MatrixXd& rigid, int count, const std::string& inputHash);
 
 } // namespace quiver

@@ -6,6 +6,8 @@
 
 #include "common/reduced_energy.h"
 #include "formats/model/qvr_writer.h"
+#include "precompute/checkpoint.h"
+#include "precompute/input_hash.h"
 
 namespace quiver {
 
@@ -42,6 +44,46 @@ EnergyPolynomial computeEnergyPolynomial(MPI_Comm comm, const TetMesh& mesh, con
   out.coefficients.resize(local.size());
   MPI_Allreduce(local.data(), out.coefficients.data(), static_cast<int>(local.size()), MPI_DOUBLE, MPI_SUM, comm);
   return out;
+}
+
+void writePolynomial(Archive& archive, const EnergyPolynomial& energy, const std::string& inputHash) {
+  resetGroup(archive, "/polynomials");
+  writeVector(archive, "/polynomials/energy_coefficients", energy.coefficients);
+  archive.setAttribute("/polynomials", "r", static_cast<int64_t>(energy.r));
+  finishGroup(archive, "/polynomials", inputHash);
+}
+
+EnergyPolynomial readPolynomial(const Archive& archive) {
+  EnergyPolynomial energy;
+  energy.r = static_cast<int>(archive.intAttribute("/polynomials", "r"));
+  energy.coefficients = readVector(archive, "/polynomials/energy_coefficients");
+  return energy;
+}
+
+std::string polynomialInputHash(const std::string& basisHash) {
+  return InputHash().add(basisHash).add(std::string("polynomials 1")).hex();
+}
+
+std::string describePolynomial(const EnergyPolynomial& energy, int tets, double seconds) {
+  return std::to_string(energy.coefficients.size()) + " energy coefficients (exact, r = " + std::to_string(energy.r) +
+         "), " + shortNumber(1e6 * seconds / tets) + " us per tet";
+}
+
+EnergyPolynomial polynomialStage(StageRunner& stages, const BakeContext& ctx, const TetMesh& mesh,
+                                 const std::vector<Material>& perTet, const std::vector<int>& tetPart,
+                                 const Eigen::MatrixXd& basis, const std::string& inputHash) {
+  bool reused = false;
+  const EnergyPolynomial energy = stages.checkpointed(
+      "polynomials", "/polynomials", inputHash, [&](const Archive& a) { return readPolynomial(a); },
+      [&] {
+        ProgressMeter meter(ctx, "polynomials", "tets integrated (rank 0)");
+        PolynomialSettings settings;
+        settings.progress = meter.callback();
+        return computeEnergyPolynomial(ctx.comm(), mesh, perTet, tetPart, basis, settings);
+      },
+      [&](Archive& a, const EnergyPolynomial& e, const std::string& h) { writePolynomial(a, e, h); }, reused);
+  stages.report(describePolynomial(energy, mesh.tetCount(), stages.last()), reused);
+  return energy;
 }
 
 } // namespace quiver

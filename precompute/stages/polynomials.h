@@ -5,13 +5,16 @@
 // the machine's peak rather than scalar loops. One reduction adds the ranks' sums, folded into the
 // .qvr's monomial coefficients.
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
 #include <mpi.h>
 
 #include "common/tet_mesh.h"
+#include "precompute/archive/archive.h"
 #include "precompute/progress_meter.h"
+#include "precompute/stage_runner.h"
 
 namespace quiver {
 
@@ -32,5 +35,17 @@ struct EnergyPolynomial {
 EnergyPolynomial computeEnergyPolynomial(MPI_Comm comm, const TetMesh& mesh, const std::vector<Material>& perTet,
                                          const std::vector<int>& tetPart, const Eigen::MatrixXd& basis,
                                          const PolynomialSettings& settings);
+
+// Checkpoint: group /polynomials. Input hash: the basis's and the stage's version tag.
+std::string polynomialInputHash(const std::string& basisHash);
+void writePolynomial(Archive& archive, const EnergyPolynomial& energy, const std::string& inputHash);
+EnergyPolynomial readPolynomial(const Archive& archive);
+// Progress: "46345 energy coefficients (exact, r = 30), 42 us per tet".
+std::string describePolynomial(const EnergyPolynomial& energy, int tets, double seconds);
+
+// The stage as the bake runs it: checkpointed under `inputHash`, with its progress line.
+EnergyPolynomial polynomialStage(StageRunner& stages, const BakeContext& ctx, const TetMesh& mesh,
+                                 const std::vector<Material>& perTet, const std::vector<int>& tetPart,
+                                 const Eigen::MatrixXd& basis, const std::string& inputHash);
 
 } // namespace quiver

@@ -102,6 +102,39 @@ double stepEnergy(const qv_instance& s, const double* q, const double* v, double
   return kinetic + elastic + S - external;
 }
 
+// The budget holds: never end a step with more. Where the position alone holds more, draw it back
+// toward the start, whose potential is within the budget; the velocity then gets what is left.
+void holdToBudget(qv_instance& s, double budget, double* x, double* velocity, double& elastic, qv_step_report& report) {
+  const int r = s.r;
+  if (stepEnergy(s, x, nullptr, elastic) > budget) {
+    // Bisection on x(t) = q + t (x - q) for the farthest t whose potential is within the budget
+    // (t = 0, the start, is); 12 halvings leave t within 1/4096 of it.
+    std::memcpy(s.work.trial, x, sizeof(double) * r);  // the far end of the segment
+    double within = 0, beyond = 1, withinElastic = s.elasticEnergyAtState;
+    for (int cut = 0; cut < 12; ++cut) {
+      const double t = 0.5 * (within + beyond);
+      for (int i = 0; i < r; ++i) x[i] = s.q[i] + t * (s.work.trial[i] - s.q[i]);
+      const double e = elasticEnergy(*s.model, s.config.elasticity, x, s.work.polynomialScratch);
+      if (stepEnergy(s, x, nullptr, e) <= budget) {
+        within = t;
+        withinElastic = e;
+      } else {
+        beyond = t;
+      }
+    }
+    for (int i = 0; i < r; ++i) x[i] = s.q[i] + within * (s.work.trial[i] - s.q[i]);
+    elastic = withinElastic;
+    report.held_back = 1;
+  }
+  const double energyAfter = stepEnergy(s, x, velocity, elastic);
+  if (energyAfter > budget) {
+    const double kinetic = 0.5 * dot(velocity, velocity, r), potential = energyAfter - kinetic;
+    const double keep = potential < budget && kinetic > 0 ? std::sqrt((budget - potential) / kinetic) : 0.0;
+    for (int i = 0; i < r; ++i) velocity[i] *= keep;
+    report.energy_removed = kinetic * (1 - keep * keep);
+  }
+}
+
 } // namespace
 
 double restDampingForce(const qv_instance& s, int i, const double* v) {
@@ -168,39 +201,9 @@ qv_step_status minimizeStep(qv_instance& s, const StepPredictor& p) {
   // Damping's share: h v_mid^T C0 v_mid, exact for the trapezoidal rule's linear damping.
   for (int i = 0; i < r; ++i) s.work.trial[i] = 0.5 * (s.v[i] + velocity[i]);
   for (int i = 0; i < r; ++i) budget -= p.h * s.work.trial[i] * restDampingForce(s, i, s.work.trial);
-  // The budget holds: never end a step with more. Where the position alone holds more, draw it
-  // back toward the start, whose potential is within the budget; the velocity then gets what is
-  // left (below).
-  const double energyBefore = budget;
-  if (stepEnergy(s, x, nullptr, elastic) > energyBefore) {
-    // Bisection on x(t) = q + t (x - q) for the farthest t whose potential is within the budget
-    // (t = 0, the start, is); 12 halvings leave t within 1/4096 of it.
-    std::memcpy(s.work.trial, x, sizeof(double) * r);  // the far end of the segment
-    double within = 0, beyond = 1, withinElastic = s.elasticEnergyAtState;
-    for (int cut = 0; cut < 12; ++cut) {
-      const double t = 0.5 * (within + beyond);
-      for (int i = 0; i < r; ++i) x[i] = s.q[i] + t * (s.work.trial[i] - s.q[i]);
-      const double e = elasticEnergy(*s.model, s.config.elasticity, x, s.work.polynomialScratch);
-      if (stepEnergy(s, x, nullptr, e) <= energyBefore) {
-        within = t;
-        withinElastic = e;
-      } else {
-        beyond = t;
-      }
-    }
-    for (int i = 0; i < r; ++i) x[i] = s.q[i] + within * (s.work.trial[i] - s.q[i]);
-    elastic = withinElastic;
-    report.held_back = 1;
-  }
-  const double energyAfter = stepEnergy(s, x, velocity, elastic);
-  if (energyAfter > energyBefore) {
-    const double kinetic = 0.5 * dot(velocity, velocity, r), potential = energyAfter - kinetic;
-    const double keep = potential < energyBefore && kinetic > 0 ? std::sqrt((energyBefore - potential) / kinetic) : 0.0;
-    for (int i = 0; i < r; ++i) velocity[i] *= keep;
-    report.energy_removed = kinetic * (1 - keep * keep);
-  }
+  holdToBudget(s, budget, x, velocity, elastic, report);
   // A step held back forfeits the slack: what it removed is not to be won back.
-  s.energySlack = report.held_back ? 0.0 : std::fmax(0.0, energyBefore - stepEnergy(s, x, velocity, elastic));
+  s.energySlack = report.held_back ? 0.0 : std::fmax(0.0, budget - stepEnergy(s, x, velocity, elastic));
   s.elasticEnergyAtState = elastic;
   return status;
 }

@@ -1,0 +1,46 @@
+#include "precompute/stages/export_model.h"
+
+#include "formats/npy.h"
+#include "precompute/distributed_dense.h"
+
+namespace quiver {
+
+namespace {
+
+// 3N x cols in the input file's vertex order (zeros for vertices the loader dropped), row-major.
+std::vector<double> inFileOrder(const Eigen::MatrixXd& full, const CheckedMesh& mesh) {
+  const int64_t cols = full.cols();
+  std::vector<double> out(3 * mesh.loadedVertex.size() * cols, 0.0);
+  for (size_t v = 0; v < mesh.fileVertex.size(); ++v)
+    for (int c = 0; c < 3; ++c)
+      for (int64_t j = 0; j < cols; ++j) out[(3 * mesh.fileVertex[v] + c) * cols + j] = full(3 * v + c, j);
+  return out;
+}
+
+} // namespace
+
+std::string exportModel(const BakeContext& ctx, const ExportRequest& request, const MeshInputs& in, Mat mass,
+                        const DofLayout& layout, const LinearModes& modes, const ReducedBasis& basis,
+                        const Eigen::MatrixXd& fullU, const EnergyPolynomial& energy) {
+  // Gravity projection U^T M e_a: the reduced force of a unit acceleration along each axis.
+  Eigen::MatrixXd axes = Eigen::MatrixXd::Zero(layout.localDofs(), 3);
+  for (Eigen::Index i = 0; i < axes.rows(); ++i) axes(i, i % 3) = 1;
+  const Eigen::MatrixXd gravity = innerProducts(basis.vectors, multiply(mass, axes, layout), ctx.comm());
+  const ModelContents contents =
+      makeModelContents(in.mesh, in.perTet, fullU, energy.coefficients, modes.eigenvalues, gravity, request.model);
+  const std::string path = request.name + ".qvr";
+  ctx.onRankZero([&] { writeModelFile(path, contents); });
+  if (request.exportNpy) {
+    const Eigen::MatrixXd fullModes = layout.gatherToAll(modes.vectors);
+    ctx.onRankZero([&] {
+      const int64_t rows = 3 * static_cast<int64_t>(in.mesh.loadedVertex.size());
+      writeNpy(request.name + ".eigenvalues.npy", {static_cast<int64_t>(modes.eigenvalues.size())},
+               modes.eigenvalues.data());
+      writeNpy(request.name + ".modes.npy", {rows, fullModes.cols()}, inFileOrder(fullModes, in.mesh).data());
+      writeNpy(request.name + ".U.npy", {rows, fullU.cols()}, inFileOrder(fullU, in.mesh).data());
+    });
+  }
+  return path;
+}
+
+} // namespace quiver

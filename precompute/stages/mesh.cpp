@@ -1,0 +1,43 @@
+#include "precompute/stages/mesh.h"
+
+#include <cstdio>
+#include <stdexcept>
+
+#include "formats/mesh/read_mesh.h"
+#include "precompute/input_hash.h"
+
+namespace quiver {
+
+MeshInputs loadMeshInputs(const MeshSettings& s) {
+  MeshInputs in;
+  in.mesh = loadMesh(s.path, s.checks);
+  in.fixed = selectFixedVertices(in.mesh, s.fixed);
+  in.perTet = resolveTetMaterials(in.mesh.mesh, s.fallback, s.material);
+  for (const Material& m : in.perTet)
+    if (std::string bad = checkMaterial(m); !bad.empty()) throw std::invalid_argument(s.path + ": " + bad);
+  InputHash h;
+  h.add(readFileBytes(s.path)).add(s.checks.fixOrientation).add(s.checks.degenerateTolerance).add(in.fixed);
+  for (const Material& m : in.perTet) h.add(m.youngsModulus).add(m.poissonRatio).add(m.density);
+  in.hash = h.hex();
+  in.freeDofs = 3 * (static_cast<int64_t>(in.mesh.mesh.vertexCount()) - static_cast<int64_t>(in.fixed.size()));
+  return in;
+}
+
+void warnAboutMesh(const BakeContext& ctx, const MeshInputs& in, const MeshSettings& s) {
+  if (ctx.rank() != 0) return;
+  for (const std::string& w : in.mesh.warnings) std::fprintf(stderr, "quiver-bake: warning: %s\n", w.c_str());
+  if (in.mesh.mesh.materials.empty() && !(s.material.youngsModulus && s.material.poissonRatio && s.material.density))
+    std::fprintf(stderr,
+                 "quiver-bake: warning: %s defines no material; using E = %g Pa, nu = %g, density = %g kg/m^3 "
+                 "where --E, --nu, --density do not say\n",
+                 s.path.c_str(), in.perTet[0].youngsModulus, in.perTet[0].poissonRatio, in.perTet[0].density);
+}
+
+std::string describeMesh(const MeshInputs& in) {
+  return std::to_string(in.mesh.mesh.vertexCount()) + " vertices, " + std::to_string(in.mesh.mesh.tetCount()) +
+         " tets, " + std::to_string(in.fixed.size()) + " fixed vertices" +
+         (in.freeObject() ? " (free object: the six rigid modes are skipped)" : "") + ", " +
+         std::to_string(in.freeDofs) + " free DOFs";
+}
+
+} // namespace quiver
