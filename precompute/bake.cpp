@@ -103,9 +103,11 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   StageRunner stages(ctx, s.resume);
   const MeshInputs in = stages.run("mesh", [&] { return loadMeshInputs(s.mesh); });
   warnAboutMesh(ctx, in, s.mesh);
-  if (s.modes + (in.freeObject() ? 6 : 0) > in.freeDofs || s.basis.settings.rank > in.freeDofs)
+  // An eigensolver needs more DOFs than modes (k at the free DOFs leaves it no room to iterate).
+  if (s.modes + (in.freeObject() ? 6 : 0) >= in.freeDofs || s.basis.settings.rank > in.freeDofs)
     throw std::invalid_argument("the mesh has " + std::to_string(in.freeDofs) + " free DOFs: too few for --modes " +
-                                std::to_string(s.modes) + " and --rank " + std::to_string(s.basis.settings.rank));
+                                std::to_string(s.modes) + (in.freeObject() ? " (+ 6 rigid)" : "") + " and --rank " +
+                                std::to_string(s.basis.settings.rank));
   stages.report(describeMesh(in));
   const Partition partition = stages.run("partition", [&] { return partitionMesh(in.mesh.mesh, {ctx.size()}); });
   stages.report(std::to_string(ctx.size()) + " part(s), " + std::to_string(partition.cutFaces) + " cut faces");

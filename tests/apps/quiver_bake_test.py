@@ -107,6 +107,7 @@ class QuiverBake(unittest.TestCase):
             (["--modes", "3", "--rank", "10", "--exact-rank"], "--rank 10 exceeds the 9 vectors"),
             (["--modes", "3", "--rank", "4", "--basis", "modes", "--exact-rank"], "--rank 4 exceeds the 3 vectors"),
             (["--fix", "x>-1", "--modes", "2", "--rank", "3"], "free DOFs"),
+            (["--E", "nan"], "Young's modulus E = nan"),
             (["--basis-from", os.path.join(self.dir, "none.npy")], "none.npy"),
             (["--basis-from", os.path.join(self.dir, "beam1.h5:/nothing")], "/nothing"),
         ]
