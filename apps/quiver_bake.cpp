@@ -51,6 +51,9 @@ int main(int argc, char** argv) {
                  "Default damping stored in NAME.qvr: fraction of critical at the first mode (stiffness-proportional)")
       ->capture_default_str();
   app.add_option("--time-step", s.output.model.timeStep, "Suggested time step stored in NAME.qvr, in s")->capture_default_str();
+  app.add_flag("--no-fidelity{false}", s.fidelity.enabled,
+               "Skip the fidelity report (the reduced model against full-space StVK on static loads: serial, the "
+               "slowest stage on large meshes)");
   app.add_flag("--export-npy", s.output.exportNpy, "Also write NAME.eigenvalues.npy, NAME.modes.npy and NAME.U.npy (float64)");
   app.add_flag("--resume", s.resume, "Reuse the stages of NAME.h5.partial (or NAME.h5) whose inputs have not changed");
   app.add_option("-o,--output", s.output.name, "Output name: writes NAME.qvr, NAME.h5 and NAME.xmf")->required();

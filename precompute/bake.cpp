@@ -9,6 +9,7 @@
 #include "precompute/rigid_modes.h"
 #include "precompute/stage_runner.h"
 #include "precompute/stages/assemble.h"
+#include "precompute/stages/fidelity.h"
 #include "precompute/stages/partition.h"
 
 #ifndef QUIVER_VERSION
@@ -143,6 +144,7 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   const std::string qvr = stages.run(
       "export", [&] { return exportModel(ctx, s.output, in, system.mass, layout, modes, basis, fullU, energy); });
   stages.report(qvr);
+  if (s.fidelity.enabled) fidelityStage(stages, ctx, in, fullU, modes, *archive);
 
   finishArchive(ctx, s, *archive, stages, in, static_cast<int>(modes.vectors.cols()),
                 static_cast<int>(derivatives.vectors.cols()), static_cast<int>(basis.vectors.cols()));

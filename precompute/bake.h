@@ -1,6 +1,7 @@
 #pragma once
 // The whole bake, stage after stage, on every rank of the BakeContext: load and check the mesh,
-// partition, assemble, modes, modal derivatives, basis, reduced polynomials; results go to NAME.qvr
+// partition, assemble, modes, modal derivatives, basis, reduced polynomials, export, fidelity;
+// results go to NAME.qvr
 // (the runtime model), NAME.h5 (every stage, written as NAME.h5.partial and renamed when
 // complete), NAME.xmf, and with exportNpy NAME.*.npy.
 #include <string>
@@ -9,6 +10,7 @@
 #include "precompute/bake_context.h"
 #include "precompute/stages/basis.h"
 #include "precompute/stages/export_model.h"
+#include "precompute/stages/fidelity.h"
 #include "precompute/stages/mesh.h"
 
 namespace quiver {
@@ -18,6 +20,7 @@ struct BakeSettings {
   int modes = 20;              // k, linear modes
   BasisRequest basis;          // r and the recipe, or a user basis (stages/basis.h)
   ExportRequest output;        // NAME, how NAME.qvr stores the model, the .npy exports (stages/export_model.h)
+  FidelitySettings fidelity;   // the reduced model against full space at the end (stages/fidelity.h)
   bool resume = false;         // reuse stages of NAME.h5.partial / NAME.h5 whose inputs hash the same
   std::string commandLine;     // for provenance
   std::string petscOptions;    // the PETSc/SLEPc options given, part of the modes' input hash

@@ -20,9 +20,11 @@ def command(ranks, *args):
     return [MPIEXEC, "-n", str(ranks), "--oversubscribe", BAKE, *map(str, args)]
 
 
-def bake(ranks, *args, timeout=300):
-    return subprocess.run(command(ranks, *args), capture_output=True, text=True, timeout=timeout,
-                          stdin=subprocess.DEVNULL)
+def bake(ranks, *args, timeout=300, fidelity=False):
+    """The fidelity report (full-space static solves) only where a test looks at it: it is the
+    slowest stage and most tests are about others."""
+    return subprocess.run(command(ranks, *args, *([] if fidelity else ["--no-fidelity"])), capture_output=True,
+                          text=True, timeout=timeout, stdin=subprocess.DEVNULL)
 
 
 def descendants(pid):
@@ -128,6 +130,48 @@ class QuiverBake(unittest.TestCase):
         self.assertNotEqual(p.returncode, 0)
         self.assertIn("svd not in {pca,keep-modes,modes}", p.stderr)
 
+    def test_fidelity_report(self):
+        """The report's numbers: a basis of every free DOF is the full model, so every case reads 0%
+        and every frequency is exact; the recipes' own bases read what they lose; --no-fidelity skips it."""
+        import re
+
+        def report(*args):
+            p = bake(1, *args, fidelity=True)
+            self.assertEqual(p.returncode, 0, p.stderr)
+            line = next((l for l in p.stdout.splitlines() if "fidelity:" in l), None)
+            self.assertIsNotNone(line, p.stdout)
+            cases = {name: float(x) / 100 for name, x in re.findall(r"(own weight|pull|twist 30|twist 60) ([0-9.e+-]+)% off", line)}
+            close, total = map(int, re.search(r"(\d+) of the (\d+) baked frequencies", line).groups())
+            return cases, close, total
+
+        tiny = os.path.join(self.dir, "tiny.vtu")
+        subprocess.run([MESH, "beam", "--size", "1,0.1,0.1", "--cells", "3,1,1", "-o", tiny], check=True)
+        # 16 vertices, the 4 at x = 0 fixed: 36 free DOFs, each its own basis vector.
+        identity = np.zeros((48, 36))
+        try:
+            import meshio  # the file's vertex order
+        except ImportError:
+            self.skipTest("python3-meshio not installed")
+        points = meshio.read(tiny).points
+        free = [v for v in range(len(points)) if points[v][0] > 1e-9]
+        for j, v in enumerate(free):
+            for c in range(3):
+                identity[3 * v + c, 3 * j + c] = 1
+        np.save(os.path.join(self.dir, "identity.npy"), identity)
+        common = [tiny, "--fix", "x<min+1e-9", "--E", "1e6", "--nu", "0.4", "--density", "1000", "--modes", "6"]
+        cases, close, total = report(*common, "--basis-from", os.path.join(self.dir, "identity.npy"),
+                                     "-o", os.path.join(self.dir, "complete"))
+        self.assertEqual(sorted(cases), ["own weight", "pull", "twist 30", "twist 60"])
+        self.assertLess(max(cases.values()), 1e-6, cases)
+        self.assertEqual((close, total), (6, 6))
+        cases, close, total = report(*common, "--rank", "8", "-o", os.path.join(self.dir, "partial"))
+        self.assertGreater(max(cases.values()), 1e-3, cases)  # 8 of 36 directions lose something
+        cases, close, total = report(*common, "--basis", "keep-modes", "--rank", "8", "-o", os.path.join(self.dir, "kept"))
+        self.assertEqual((close, total), (6, 6))
+        p = bake(1, *common, "-o", os.path.join(self.dir, "none"))  # the helper adds --no-fidelity
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertNotIn("fidelity", p.stdout)
+
     def test_missing_mesh_is_named(self):
         p = bake(2, os.path.join(self.dir, "none.msh"), "-o", os.path.join(self.dir, "b"))
         self.assertNotEqual(p.returncode, 0)
@@ -159,7 +203,7 @@ class QuiverBake(unittest.TestCase):
         subprocess.run([MESH, "beam", "--size", "1,0.1,0.15", "--cells", "48,6,9", "-o", big], check=True)
         name = os.path.join(self.dir, "killed")
         args = [big, "--fix", "x<min+1e-9", "--E", "1e6", "--nu", "0.45", "--density", "1000", "--modes", "10",
-                "--rank", "20", "--export-npy", "-o", name]
+                "--rank", "20", "--export-npy", "--no-fidelity", "-o", name]
         proc = subprocess.Popen(command(2, *args), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                 stdin=subprocess.DEVNULL)
         for line in proc.stdout:
