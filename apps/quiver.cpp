@@ -22,8 +22,7 @@ using nlohmann::ordered_json;
 namespace {
 
 // Section names and sizes straight from the file's table (already validated by the loader).
-ordered_json sectionSizes(const std::string& path) {
-  const std::string bytes = quiver::readFileBytes(path);
+ordered_json sectionSizes(const std::string& bytes) {
   auto u32 = [&](size_t at) { uint32_t v; std::memcpy(&v, &bytes[at], 4); return v; };
   auto u64 = [&](size_t at) { uint64_t v; std::memcpy(&v, &bytes[at], 8); return v; };
   ordered_json out = ordered_json::object();
@@ -56,6 +55,30 @@ std::vector<double> parseQ(const std::string& text, int r) {
   return q;
 }
 
+// The bake's fidelity report from the file's FIDELITY section (null when it has none): per load
+// case the relative displacement error and the full solution's largest displacement as a fraction
+// of the size (null: not measured), and the reduced frequencies' errors.
+ordered_json fidelityOf(const std::string& bytes) {
+  const std::vector<double> aligned((bytes.size() + 7) / 8);
+  std::memcpy(const_cast<double*>(aligned.data()), bytes.data(), bytes.size());
+  quiver::ModelView view;
+  std::string error;
+  if (!quiver::parseModel(aligned.data(), bytes.size(), view, error)) throw std::runtime_error(error);
+  if (!view.fidelityCaseCount && !view.fidelityFrequencyCount) return nullptr;
+  const auto value = [](double x) { return std::isnan(x) ? ordered_json(nullptr) : ordered_json(x); };
+  ordered_json cases = ordered_json::object();
+  for (uint32_t i = 0; i < view.fidelityCaseCount; ++i) {
+    const unsigned char* record = view.fidelityCases + i * quiver::qvr::kFidelityRecordSize;
+    double e, largest;
+    std::memcpy(&e, record + quiver::qvr::kFidelityNameSize, 8);
+    std::memcpy(&largest, record + quiver::qvr::kFidelityNameSize + 8, 8);
+    cases[reinterpret_cast<const char*>(record)] = {{"displacement_error", value(e)}, {"largest_displacement", value(largest)}};
+  }
+  return {{"cases", cases},
+          {"frequency_errors", std::vector<double>(view.fidelityFrequencyErrors,
+                                                   view.fidelityFrequencyErrors + view.fidelityFrequencyCount)}};
+}
+
 // `quiver info`: counts, section sizes, baked and reduced frequencies, material, damping, box.
 ordered_json describeModel(const quiver::app::RuntimeModel& model) {
   const qv_model_info& mi = model.info();
@@ -66,7 +89,8 @@ ordered_json describeModel(const quiver::app::RuntimeModel& model) {
   out["surface_triangles"] = mi.triangle_count;
   out["file_vertices"] = mi.file_vertex_count;
   out["basis_precision"] = mi.basis_precision;
-  out["sections"] = sectionSizes(model.path());
+  const std::string bytes = quiver::readFileBytes(model.path());
+  out["sections"] = sectionSizes(bytes);
   std::vector<double> hz;
   for (int i = 0; i < mi.eigenvalue_count; ++i)
     hz.push_back(std::sqrt(std::max(qv_model_eigenvalues(model.get())[i], 0.0)) / (2 * M_PI));
@@ -83,6 +107,7 @@ ordered_json describeModel(const quiver::app::RuntimeModel& model) {
   out["time_step"] = mi.time_step;
   out["bbox"] = {{"min", {mi.bbox_min[0], mi.bbox_min[1], mi.bbox_min[2]}},
                  {"max", {mi.bbox_max[0], mi.bbox_max[1], mi.bbox_max[2]}}};
+  out["fidelity"] = fidelityOf(bytes);
   return out;
 }
 

@@ -141,10 +141,12 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   const Eigen::MatrixXd fullU = layout.gatherToAll(basis.vectors);
   const EnergyPolynomial energy =
       polynomialStage(stages, ctx, in.mesh.mesh, in.perTet, partition.tetPart, fullU, polynomialInputHash(basisHash));
-  const std::string qvr = stages.run(
-      "export", [&] { return exportModel(ctx, s.output, in, system.mass, layout, modes, basis, fullU, energy); });
+  const FidelityReport fidelity =
+      s.fidelity.enabled ? fidelityStage(stages, ctx, in, fullU, modes, *archive) : FidelityReport{};
+  const std::string qvr = stages.run("export", [&] {
+    return exportModel(ctx, s.output, in, system.mass, layout, modes, basis, fullU, energy, fidelity);
+  });
   stages.report(qvr);
-  if (s.fidelity.enabled) fidelityStage(stages, ctx, in, fullU, modes, *archive);
 
   finishArchive(ctx, s, *archive, stages, in, static_cast<int>(modes.vectors.cols()),
                 static_cast<int>(derivatives.vectors.cols()), static_cast<int>(basis.vectors.cols()));

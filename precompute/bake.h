@@ -1,6 +1,6 @@
 #pragma once
 // The whole bake, stage after stage, on every rank of the BakeContext: load and check the mesh,
-// partition, assemble, modes, modal derivatives, basis, reduced polynomials, export, fidelity;
+// partition, assemble, modes, modal derivatives, basis, reduced polynomials, fidelity, export;
 // results go to NAME.qvr
 // (the runtime model), NAME.h5 (every stage, written as NAME.h5.partial and renamed when
 // complete), NAME.xmf, and with exportNpy NAME.*.npy.

@@ -40,8 +40,15 @@ enum SectionType : uint32_t {
   kEigenvalues = 8,
   kTets = 9,             // optional: readers need not have it
   kModalRotations = 10,  // optional (written with the optional flag, so 1.0 readers skip it)
+  kFidelity = 11,        // optional, likewise: the bake's fidelity report
 };
-constexpr uint32_t kLastKnownType = kModalRotations;
+constexpr uint32_t kLastKnownType = kFidelity;
+
+// FIDELITY: u32 case count c (<= kMaxFidelityCases), u32 frequency count f (<= the eigenvalue
+// count), c records of kFidelityRecordSize bytes (a NUL-padded ASCII name of kFidelityNameSize
+// bytes, f64 displacement error, f64 largest displacement), then f f64 frequency errors.
+constexpr uint32_t kMaxFidelityCases = 16;
+constexpr size_t kFidelityNameSize = 24, kFidelityRecordSize = kFidelityNameSize + 16;
 
 // "MODAL_ROTATIONS", ..., or "section type N" for a type this reader does not know: the one table
 // of names, used by the reader's messages and by `quiver info`.
@@ -135,6 +142,12 @@ struct ModelView {
   const uint32_t* tets = nullptr;           // 4 tetCount vertex indices; null when the file has no TETS
   const double* rotations = nullptr;        // 3n x r, row-major: vertex v's small rotation w_v = Psi_v q (modal
                                             // warping, Choi & Ko 2005); null when the file has no MODAL_ROTATIONS
+  // The bake's fidelity report (QVR.md, FIDELITY); counts zero when the file has none. Case i's
+  // name is the NUL-terminated text at fidelityCases + i * kFidelityRecordSize, followed by its
+  // displacement error and largest displacement as little-endian f64 (NaN: not measured).
+  uint32_t fidelityCaseCount = 0, fidelityFrequencyCount = 0;
+  const unsigned char* fidelityCases = nullptr;
+  const double* fidelityFrequencyErrors = nullptr;
 };
 
 // Validates the .qvr file held in `data` (the whole file, `size` bytes, 8-byte aligned as malloc,

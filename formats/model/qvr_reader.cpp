@@ -22,7 +22,7 @@ static_assert(std::numeric_limits<float>::is_iec559 && sizeof(float) == 4, "floa
 std::string qvr::sectionName(uint32_t type) {
   static const char* const kNames[] = {"", "MODEL_INFO", "ENERGY_COEFFICIENTS", "BASIS", "REST_POSITIONS",
                                        "SURFACE_TRIANGLES", "VERTEX_MAP", "GRAVITY_PROJECTION", "EIGENVALUES", "TETS",
-                                       "MODAL_ROTATIONS"};
+                                       "MODAL_ROTATIONS", "FIDELITY"};
   static_assert(std::size(kNames) == kLastKnownType + 1, "one name for every known section type");
   return type >= 1 && type <= kLastKnownType ? kNames[type] : "section type " + std::to_string(type);
 }
@@ -179,7 +179,7 @@ private:
       if (!checkSection(s)) return false;
     }
     for (uint32_t type = kModelInfo; type <= kLastKnownType; ++type)
-      if (!byType_[type] && type != kTets && type != kModalRotations)
+      if (!byType_[type] && type != kTets && type != kModalRotations && type != kFidelity)
         return fail("missing required section " + sectionName(type));
     return true;
   }
@@ -305,6 +305,43 @@ private:
     return true;
   }
 
+  // FIDELITY: counts in range, the size they imply, printable NUL-terminated names, values finite
+  // (case values may also be NaN: not measured).
+  bool fidelity(const Section& s, uint32_t eigenvalueCount, ModelView& view) {
+    if (s.size < 8) return failIn(s, "size " + std::to_string(s.size) + " is too small for its two counts");
+    const unsigned char* p = data_ + s.offset;
+    const uint32_t cases = load32(p), frequencies = load32(p + 4);
+    if (cases > kMaxFidelityCases)
+      return failIn(s, "case count " + std::to_string(cases) + " is above " + std::to_string(kMaxFidelityCases));
+    if (frequencies > eigenvalueCount)
+      return failIn(s, "frequency count " + std::to_string(frequencies) + " is above the eigenvalue count " +
+                           std::to_string(eigenvalueCount));
+    const uint64_t expected = 8 + uint64_t{cases} * kFidelityRecordSize + 8 * uint64_t{frequencies};
+    if (s.size != expected)
+      return failIn(s, "size " + std::to_string(s.size) + " is not the " + std::to_string(expected) + " bytes of " +
+                           std::to_string(cases) + " cases and " + std::to_string(frequencies) + " frequencies");
+    for (uint32_t c = 0; c < cases; ++c) {
+      const unsigned char* record = p + 8 + c * kFidelityRecordSize;
+      const void* end = std::memchr(record, 0, kFidelityNameSize);
+      if (!end) return failIn(s, "case " + std::to_string(c) + "'s name is not NUL-terminated");
+      for (const unsigned char* ch = record; ch != end; ++ch)
+        if (*ch < 0x20 || *ch > 0x7e) return failIn(s, "case " + std::to_string(c) + "'s name is not printable ASCII");
+      for (int k = 0; k < 2; ++k) {
+        const uint64_t bits = load64(record + kFidelityNameSize + 8 * k);
+        if (!finite64(bits) && !((bits & 0x7ff0000000000000ull) == 0x7ff0000000000000ull && (bits & 0xfffffffffffffull)))
+          return failIn(s, "case " + std::to_string(c) + " holds an infinite value");
+      }
+    }
+    const unsigned char* errors = p + 8 + cases * kFidelityRecordSize;
+    for (uint32_t i = 0; i < frequencies; ++i)
+      if (!finite64(load64(errors + 8 * i))) return failIn(s, "frequency error " + std::to_string(i) + " is not finite");
+    view.fidelityCaseCount = cases;
+    view.fidelityFrequencyCount = frequencies;
+    view.fidelityCases = p + 8;
+    view.fidelityFrequencyErrors = reinterpret_cast<const double*>(errors);
+    return true;
+  }
+
   // An index array section: `groups` groups of `groupSize` distinct u32 indices below `bound`.
   bool indices(const Section& s, uint64_t groups, uint32_t groupSize, const std::string& shape, uint32_t bound,
                const char* boundName, const uint32_t*& out) {
@@ -362,6 +399,7 @@ private:
     if (byType_[kModalRotations] &&
         !floats(kModalRotations, 3 * n * r, "3 x " + vertices + " x " + rText, view.rotations))
       return false;
+    if (byType_[kFidelity] && !fidelity(*byType_[kFidelity], info.eigenvalueCount, view)) return false;
     if (!byType_[kTets]) return true;
     return indices(*byType_[kTets], info.tetCount, 4, "4 x " + std::to_string(info.tetCount) + " tets",
                    info.vertexCount, "vertexCount", view.tets);

@@ -92,6 +92,26 @@ std::string formatModel(const ModelContents& c) {
                                piece(kEigenvalues, c.eigenvalues)};
   if (!c.tets.empty()) pieces.push_back(piece(kTets, c.tets));
   if (!c.rotations.empty()) pieces.push_back(piece(kModalRotations, c.rotations, kOptionalSection));
+  std::vector<unsigned char> fidelity;
+  if (!c.fidelityCases.empty() || !c.fidelityFrequencyErrors.empty()) {
+    fidelity.assign(8 + c.fidelityCases.size() * kFidelityRecordSize + 8 * c.fidelityFrequencyErrors.size(), 0);
+    const uint32_t counts[2] = {static_cast<uint32_t>(c.fidelityCases.size()),
+                                static_cast<uint32_t>(c.fidelityFrequencyErrors.size())};
+    std::memcpy(fidelity.data(), counts, 8);
+    for (size_t i = 0; i < c.fidelityCases.size(); ++i) {
+      unsigned char* record = fidelity.data() + 8 + i * kFidelityRecordSize;
+      const auto& fc = c.fidelityCases[i];
+      if (fc.name.size() >= kFidelityNameSize)
+        throw std::runtime_error("fidelity case name '" + fc.name + "' is longer than " +
+                                 std::to_string(kFidelityNameSize - 1) + " characters");
+      std::memcpy(record, fc.name.data(), fc.name.size());
+      std::memcpy(record + kFidelityNameSize, &fc.error, 8);
+      std::memcpy(record + kFidelityNameSize + 8, &fc.largestDisplacement, 8);
+    }
+    std::memcpy(fidelity.data() + 8 + c.fidelityCases.size() * kFidelityRecordSize, c.fidelityFrequencyErrors.data(),
+                8 * c.fidelityFrequencyErrors.size());
+    pieces.push_back(piece(kFidelity, fidelity, kOptionalSection));
+  }
 
   const size_t tableSize = pieces.size() * kSectionEntrySize;
   std::vector<size_t> offsets;
@@ -153,6 +173,14 @@ ModelContents copyModel(const ModelView& view) {
   c.eigenvalues.assign(view.eigenvalues, view.eigenvalues + info.eigenvalueCount);
   if (view.tets) c.tets.assign(view.tets, view.tets + size_t{4} * info.tetCount);
   if (view.rotations) c.rotations.assign(view.rotations, view.rotations + size_t{3} * info.vertexCount * info.r);
+  for (uint32_t i = 0; i < view.fidelityCaseCount; ++i) {
+    const unsigned char* record = view.fidelityCases + i * kFidelityRecordSize;
+    ModelContents::FidelityCase fc{reinterpret_cast<const char*>(record), 0, 0};
+    std::memcpy(&fc.error, record + kFidelityNameSize, 8);
+    std::memcpy(&fc.largestDisplacement, record + kFidelityNameSize + 8, 8);
+    c.fidelityCases.push_back(fc);
+  }
+  c.fidelityFrequencyErrors.assign(view.fidelityFrequencyErrors, view.fidelityFrequencyErrors + view.fidelityFrequencyCount);
   return c;
 }
 

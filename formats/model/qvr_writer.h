@@ -21,6 +21,13 @@ struct ModelContents {
   std::vector<double> eigenvalues;    // info.eigenvalueCount
   std::vector<uint32_t> tets;         // 4 x info.tetCount, or empty to leave the TETS section out
   std::vector<double> rotations;      // 3n x r modal rotations (see ModelView), or empty to leave them out
+  // The bake's fidelity report (see ModelView), or no cases and no frequencies to leave it out.
+  struct FidelityCase {
+    std::string name;                 // printable ASCII, shorter than kFidelityNameSize
+    double error, largestDisplacement;  // NaN: not measured
+  };
+  std::vector<FidelityCase> fidelityCases;
+  std::vector<double> fidelityFrequencyErrors;
 };
 
 // The ENERGY_COEFFICIENTS of q^T A2 q + 2 q^T A3 z + z^T A4 z (z the products q_j q_k, j <= k, in

@@ -21,13 +21,16 @@ std::vector<double> inFileOrder(const Eigen::MatrixXd& full, const CheckedMesh& 
 
 std::string exportModel(const BakeContext& ctx, const ExportRequest& request, const MeshInputs& in, Mat mass,
                         const DofLayout& layout, const LinearModes& modes, const ReducedBasis& basis,
-                        const Eigen::MatrixXd& fullU, const EnergyPolynomial& energy) {
+                        const Eigen::MatrixXd& fullU, const EnergyPolynomial& energy, const FidelityReport& fidelity) {
   // Gravity projection U^T M e_a: the reduced force of a unit acceleration along each axis.
   Eigen::MatrixXd axes = Eigen::MatrixXd::Zero(layout.localDofs(), 3);
   for (Eigen::Index i = 0; i < axes.rows(); ++i) axes(i, i % 3) = 1;
   const Eigen::MatrixXd gravity = innerProducts(basis.vectors, multiply(mass, axes, layout), ctx.comm());
-  const ModelContents contents =
+  ModelContents contents =
       makeModelContents(in.mesh, in.perTet, fullU, energy.coefficients, modes.eigenvalues, gravity, request.model);
+  for (const FidelityCase& c : fidelity.cases)
+    contents.fidelityCases.push_back({c.name, c.error, c.largestDisplacement});
+  contents.fidelityFrequencyErrors = fidelity.frequencyErrors;
   const std::string path = request.name + ".qvr";
   ctx.onRankZero([&] { writeModelFile(path, contents); });
   if (request.exportNpy) {

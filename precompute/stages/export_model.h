@@ -1,6 +1,6 @@
 #pragma once
-// Stage "export": NAME.qvr, the runtime model (formats/model_contents.h), from the bake's results
-// and the gravity projection U^T M e_a computed here; with exportNpy also NAME.eigenvalues.npy,
+// Stage "export": NAME.qvr, the runtime model (formats/model_contents.h), from the bake's results,
+// the gravity projection U^T M e_a computed here and the fidelity report (its FIDELITY section); with exportNpy also NAME.eigenvalues.npy,
 // NAME.modes.npy and NAME.U.npy (3N rows in the mesh file's vertex order). Collective; rank 0 writes.
 #include <string>
 
@@ -11,6 +11,7 @@
 #include "precompute/bake_context.h"
 #include "precompute/dof_layout.h"
 #include "precompute/stages/basis.h"
+#include "precompute/stages/fidelity.h"
 #include "precompute/stages/mesh.h"
 #include "precompute/stages/modes.h"
 #include "precompute/stages/polynomials.h"
@@ -26,6 +27,6 @@ struct ExportRequest {
 // `fullU`: the basis gathered to every rank (3n x r, vertex order). Returns the .qvr's path.
 std::string exportModel(const BakeContext& ctx, const ExportRequest& request, const MeshInputs& inputs, Mat mass,
                         const DofLayout& layout, const LinearModes& modes, const ReducedBasis& basis,
-                        const Eigen::MatrixXd& fullU, const EnergyPolynomial& energy);
+                        const Eigen::MatrixXd& fullU, const EnergyPolynomial& energy, const FidelityReport& fidelity);
 
 } // namespace quiver

@@ -188,6 +188,15 @@ class SpreadSpectrum(unittest.TestCase):
         info = json.loads(run(QUIVER, "info", out + ".qvr").stdout)
         baked, reduced = np.array(info["frequencies_hz"]), np.sort(info["reduced_frequencies_hz"])[:20]
         np.testing.assert_allclose(reduced, baked, rtol=1e-6)
+        # The bake's fidelity report says the same through quiver info, and what it could not measure.
+        report = info["fidelity"]
+        self.assertEqual(list(report["cases"]), ["own weight", "pull", "twist 30", "twist 60"])
+        self.assertLess(np.max(np.abs(report["frequency_errors"])), 1e-6)
+        self.assertEqual(len(report["frequency_errors"]), 20)
+        self.assertIsNone(report["cases"]["own weight"]["displacement_error"])  # a 30 m beam folds under its weight
+        self.assertTrue(np.isfinite(report["cases"]["pull"]["displacement_error"]))
+        none, _ = self.bake(30, "--basis", "modes", "--rank", 10, "--no-fidelity")
+        self.assertIsNone(json.loads(run(QUIVER, "info", none + ".qvr").stdout)["fidelity"])
         pca, _ = self.bake(30, "--basis", "pca", "--rank", 30)
         info = json.loads(run(QUIVER, "info", pca + ".qvr").stdout)
         worst = np.max(np.abs(np.sort(info["reduced_frequencies_hz"])[:20] / baked - 1))

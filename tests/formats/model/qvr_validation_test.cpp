@@ -237,4 +237,44 @@ TEST(QvrValidation, ModelInfoAndArraysAreChecked) {
 }
 
 } // namespace
+// The FIDELITY section: the bake's report round-trips (NaN for "not measured" included) and every
+// field is checked: counts, the size they imply, names, values.
+TEST(QvrValidation, TheFidelityReportRoundTripsAndIsChecked) {
+  ModelContents c = test::syntheticModel();
+  c.fidelityCases = {{"own weight", 0.003, 0.4}, {"twist 30", kNaN, kNaN}};
+  c.fidelityFrequencyErrors = {1e-3, -2e-4};
+  const std::string f = formatModel(c);
+  {
+    test::AlignedFile file(f);
+    ModelView view;
+    std::string error;
+    ASSERT_TRUE(file.parse(view, error)) << error;
+    ASSERT_EQ(view.fidelityCaseCount, 2u);
+    ASSERT_EQ(view.fidelityFrequencyCount, 2u);
+    const ModelContents back = copyModel(view);
+    EXPECT_EQ(back.fidelityCases[0].name, "own weight");
+    EXPECT_EQ(back.fidelityCases[0].error, 0.003);
+    EXPECT_EQ(back.fidelityCases[1].name, "twist 30");
+    EXPECT_TRUE(std::isnan(back.fidelityCases[1].largestDisplacement));
+    EXPECT_EQ(back.fidelityFrequencyErrors, c.fidelityFrequencyErrors);
+    EXPECT_EQ(formatModel(back), f) << "a copy writes the same bytes";
+  }
+  // Where the section is: the last table entry (the writer puts sections in type order).
+  const uint64_t count = test::getLE(f, 20, 4);
+  const size_t at = test::getLE(f, entry(count - 1) + 8, 8);
+  ASSERT_EQ(test::getLE(f, entry(count - 1), 4), uint64_t{qvr::kFidelity});
+  EXPECT_REFUSED(patched(f, at, 17, 4), "FIDELITY at byte " + std::to_string(at) + ": case count 17 is above 16");
+  EXPECT_REFUSED(patched(f, at + 4, 3, 4), "frequency count 3 is above the eigenvalue count 2");
+  EXPECT_REFUSED(patched(f, at, 1, 4), "is not the 64 bytes of 1 cases and 2 frequencies");
+  std::string unterminated = f;
+  for (size_t k = 0; k < qvr::kFidelityNameSize; ++k) unterminated[at + 8 + k] = 'x';
+  test::reseal(unterminated);
+  EXPECT_REFUSED(unterminated, "case 0's name is not NUL-terminated");
+  EXPECT_REFUSED(patched(f, at + 8, 0x07, 1), "case 0's name is not printable ASCII");
+  EXPECT_REFUSED(patched(f, at + 8 + qvr::kFidelityNameSize, test::bitsOf(kInf), 8), "case 0 holds an infinite value");
+  EXPECT_REFUSED(patched(f, at + 8 + 2 * qvr::kFidelityRecordSize, test::bitsOf(kNaN), 8), "frequency error 0 is not finite");
+  c.fidelityCases[0].name = std::string(qvr::kFidelityNameSize, 'n');
+  EXPECT_THROW(formatModel(c), std::runtime_error);
+}
+
 } // namespace quiver
