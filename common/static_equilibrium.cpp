@@ -103,6 +103,9 @@ Eigen::VectorXd solveStatic(const StVKForceModel& model, const std::vector<Eigen
     return out;
   };
   Energy energy{model, rest, load};
+  // The Hessian's pattern never changes (K's, the springs' diagonal): order it once.
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+  bool analyzed = false;
   const auto direction = [&](const Eigen::VectorXd& u, const Eigen::VectorXd& g) {
     Eigen::SparseMatrix<double> H = energy.hessian(u);
     std::vector<int> index(n, -1);
@@ -119,8 +122,12 @@ Eigen::VectorXd solveStatic(const StVKForceModel& model, const std::vector<Eigen
     Hf.setFromTriplets(entries.begin(), entries.end());
     Eigen::SparseMatrix<double> I(Hf.rows(), Hf.cols());
     I.setIdentity();
+    if (!analyzed) {
+      ldlt.analyzePattern(Hf);
+      analyzed = true;
+    }
     for (double mu = 0;; mu = mu > 0 ? 10 * mu : 1e-8 * largest) {
-      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(Hf + mu * I);
+      ldlt.factorize(Hf + mu * I);
       if (ldlt.info() == Eigen::Success && ldlt.vectorD().minCoeff() > 0) return Eigen::VectorXd(ldlt.solve(-g));
       if (mu > 1e6 * largest) throw std::runtime_error("static equilibrium: the Hessian cannot be made positive definite");
     }

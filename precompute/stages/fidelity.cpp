@@ -77,6 +77,11 @@ std::vector<std::pair<std::string, StaticLoad>> loadCases(const MeshInputs& in) 
 FidelityReport measure(const MeshInputs& in, const Eigen::MatrixXd& U, const LinearModes& modes) {
   const TetMesh& m = in.mesh.mesh;
   const StVKForceModel model(m, in.perTet);
+  // Percent-level answers: four load increments and a gradient of 1e-7 are plenty.
+  StaticSettings settings;
+  settings.increments = 4;
+  settings.tolerance = 1e-7;
+  settings.accepted = 1e-5;
   FidelityReport report;
   const auto box = boundingBox(m);
   const double size = (box[1] - box[0]).norm();
@@ -86,8 +91,8 @@ FidelityReport measure(const MeshInputs& in, const Eigen::MatrixXd& U, const Lin
       // folds) is reported as not measured (NaN): the report never fails the bake.
       FidelityCase measured{name, std::nan(""), std::nan("")};
       try {
-        const Eigen::VectorXd full = solveStatic(model, m.vertices, in.fixed, load);
-        const Eigen::VectorXd reduced = solveStaticReduced(model, m.vertices, U, load);
+        const Eigen::VectorXd full = solveStatic(model, m.vertices, in.fixed, load, settings);
+        const Eigen::VectorXd reduced = solveStaticReduced(model, m.vertices, U, load, settings);
         double largest = 0;
         for (int v = 0; v < m.vertexCount(); ++v) largest = std::max(largest, full.segment<3>(3 * v).norm());
         measured.error = (reduced - full).norm() / full.norm();
