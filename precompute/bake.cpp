@@ -5,7 +5,6 @@
 #include <memory>
 
 #include "precompute/archive/xdmf.h"
-#include "precompute/checkpoint.h"
 #include "precompute/rigid_modes.h"
 #include "precompute/stage_runner.h"
 #include "precompute/stages/assemble.h"
@@ -115,7 +114,8 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
 
   const std::unique_ptr<Archive> archive = openArchive(ctx, s);
   stages.setArchive(archive.get());
-  writeInputs(*archive, in.mesh, s.mesh.path, in.perTet, in.fixed, partition, ctx.size());
+  writeMeshInputs(*archive, in, s.mesh.path);
+  writePartition(*archive, partition, ctx.size());
   const DofLayout layout(ctx.comm(), partition.vertexPart, in.fixed);
   const AssembledSystem system =
       stages.run("assemble", [&] { return assembleSystem(in.mesh.mesh, in.perTet, partition.tetPart, layout); });

@@ -5,21 +5,13 @@
 // leaves groups without it, and --resume recomputes those.
 #include <string>
 
-#include "common/tet_mesh.h"
-#include "common/mesh_checks.h"
 #include "precompute/archive/archive.h"
 #include "precompute/dof_layout.h"
-#include "precompute/stages/partition.h"
 
 namespace quiver {
 
 // The stage's stored input hash, or "" when the group is missing or incomplete.
 std::string storedInputHash(const Archive& archive, const std::string& group);
-
-// /mesh, /material, /constraints and /partition: the inputs, rewritten on every run.
-void writeInputs(Archive& archive, const CheckedMesh& mesh, const std::string& sourceFile,
-                 const std::vector<Material>& perTet, const std::vector<int>& fixedVertices,
-                 const Partition& partition, int ranks);
 
 // Starts a stage group afresh (whatever a killed run left there goes first); finishes it by
 // writing its input hash last.

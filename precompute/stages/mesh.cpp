@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "formats/mesh/read_mesh.h"
+#include "precompute/checkpoint.h"
 #include "precompute/input_hash.h"
 
 namespace quiver {
@@ -31,6 +32,39 @@ void warnAboutMesh(const BakeContext& ctx, const MeshInputs& in, const MeshSetti
                  "quiver-bake: warning: %s defines no material; using E = %g Pa, nu = %g, density = %g kg/m^3 "
                  "where --E, --nu, --density do not say\n",
                  s.path.c_str(), in.perTet[0].youngsModulus, in.perTet[0].poissonRatio, in.perTet[0].density);
+}
+
+void writeMeshInputs(Archive& archive, const MeshInputs& in, const std::string& sourceFile) {
+  const TetMesh& m = in.mesh.mesh;
+  const int64_t n = m.vertexCount(), t = m.tetCount();
+  resetGroup(archive, "/mesh");
+  std::vector<double> xyz;
+  for (const auto& x : m.vertices) xyz.insert(xyz.end(), {x.x(), x.y(), x.z()});
+  archive.writeReplicated("/mesh/vertices", {n, 3}, xyz.data());
+  std::vector<int32_t> tets;
+  for (const Tet& tet : m.tets) tets.insert(tets.end(), tet.begin(), tet.end());
+  archive.writeReplicated("/mesh/tets", {t, 4}, tets.data());
+  archive.writeReplicated("/mesh/tet_region", {t}, m.tetRegion.data());
+  const std::vector<int64_t> fileVertex(in.mesh.fileVertex.begin(), in.mesh.fileVertex.end());
+  archive.writeReplicated("/mesh/file_vertex", {n}, fileVertex.data());
+  archive.setAttribute("/mesh", "source_file", sourceFile);
+  archive.setAttribute("/mesh", "file_vertex_count", static_cast<int64_t>(in.mesh.loadedVertex.size()));
+
+  resetGroup(archive, "/material");
+  std::vector<double> E, nu, rho;
+  for (const Material& mat : in.perTet) {
+    E.push_back(mat.youngsModulus);
+    nu.push_back(mat.poissonRatio);
+    rho.push_back(mat.density);
+  }
+  writeVector(archive, "/material/youngs_modulus", E);
+  writeVector(archive, "/material/poisson_ratio", nu);
+  writeVector(archive, "/material/density", rho);
+
+  resetGroup(archive, "/constraints");
+  archive.writeReplicated("/constraints/fixed_vertices", {static_cast<int64_t>(in.fixed.size())}, in.fixed.data());
+  archive.setAttribute("/constraints", "fixed_dof_count", static_cast<int64_t>(3 * in.fixed.size()));
+  archive.flush();
 }
 
 std::string describeMesh(const MeshInputs& in) {

@@ -9,6 +9,7 @@
 #include "common/fixed_vertices.h"
 #include "common/material.h"
 #include "common/mesh_checks.h"
+#include "precompute/archive/archive.h"
 #include "precompute/bake_context.h"
 
 namespace quiver {
@@ -36,6 +37,10 @@ MeshInputs loadMeshInputs(const MeshSettings& settings);
 // Rank 0 warns on stderr: what the checks repaired, and a mesh without materials whose values the
 // command line leaves to the defaults.
 void warnAboutMesh(const BakeContext& ctx, const MeshInputs& inputs, const MeshSettings& settings);
+
+// Checkpoint: groups /mesh, /material and /constraints, rewritten on every run; the bake never
+// reads them back (later stages' hashes build on `inputs.hash`). `sourceFile` is recorded as given.
+void writeMeshInputs(Archive& archive, const MeshInputs& inputs, const std::string& sourceFile);
 
 // Progress: "189 vertices, 480 tets, 9 fixed vertices, 540 free DOFs".
 std::string describeMesh(const MeshInputs& inputs);

@@ -6,6 +6,8 @@
 
 #include <metis.h>
 
+#include "precompute/checkpoint.h"
+
 namespace quiver {
 
 Partition partitionMesh(const TetMesh& mesh, const PartitionSettings& settings) {
@@ -35,6 +37,16 @@ Partition partitionMesh(const TetMesh& mesh, const PartitionSettings& settings) 
   for (int t = 0; t < ne; ++t)
     for (int v : mesh.tets[t]) p.vertexPart[v] = std::min(p.vertexPart[v], p.tetPart[t]);
   return p;
+}
+
+void writePartition(Archive& archive, const Partition& partition, int ranks) {
+  resetGroup(archive, "/partition");
+  archive.writeReplicated("/partition/tet_part", {static_cast<int64_t>(partition.tetPart.size())},
+                          partition.tetPart.data());
+  archive.writeReplicated("/partition/vertex_part", {static_cast<int64_t>(partition.vertexPart.size())},
+                          partition.vertexPart.data());
+  archive.setAttribute("/partition", "ranks", static_cast<int64_t>(ranks));
+  archive.flush();
 }
 
 } // namespace quiver

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "common/tet_mesh.h"
+#include "precompute/archive/archive.h"
 
 namespace quiver {
 
@@ -21,5 +22,8 @@ struct Partition {
 
 // Throws std::runtime_error when METIS fails.
 Partition partitionMesh(const TetMesh& mesh, const PartitionSettings& settings);
+
+// Checkpoint: group /partition, rewritten on every run; the bake never reads it back.
+void writePartition(Archive& archive, const Partition& partition, int ranks);
 
 } // namespace quiver
