@@ -1,7 +1,9 @@
 #pragma once
 // A stable 64-bit FNV-1a hash of everything a bake stage depends on, stored with the stage's
 // results so that --resume can tell whether they are still valid. Not cryptographic: it guards
-// against changed inputs, not against forgery.
+// against changed inputs, not against forgery. Each stage's recipe ends with the stage's version
+// tag (k<Stage>Version beside the recipe): a stage that computes something else from the same
+// inputs gets a new tag, so that --resume recomputes it.
 #include <cstdint>
 #include <cstring>
 #include <string>

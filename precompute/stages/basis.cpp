@@ -180,12 +180,12 @@ std::string basisInputHash(const std::string& vectorsHash, const BasisSettings& 
       .add(settings.rank)
       .add(std::string(basisKindName(settings.kind)))
       .add(settings.exactRank)
-      .add(std::string("basis 1"))
+      .add(kBasisVersion)
       .hex();
 }
 
 std::string userBasisInputHash(const std::string& meshHash, const std::string& spec) {
-  return InputHash().add(meshHash).add(spec).add(std::string("user basis 1")).hex();
+  return InputHash().add(meshHash).add(spec).add(kUserBasisVersion).hex();
 }
 
 std::string describeBasis(const ReducedBasis& basis) {

@@ -79,7 +79,10 @@ ReducedBasis importBasis(Mat mass, const DofLayout& layout, Eigen::MatrixXd rows
 double massOrthonormalize(Mat mass, const DofLayout& layout, Eigen::MatrixXd& U);
 
 // Checkpoint: group /basis. Input hash: the derivatives' (the modes' for BasisKind::Modes), r, the
-// recipe and the stage's version tag; for a user basis, the mesh stage's and the basis's spec.
+// recipe and the stage's version tag; for a user basis, the mesh stage's, the basis's spec and a
+// version tag of its own.
+inline constexpr const char* kBasisVersion = "basis 1";
+inline constexpr const char* kUserBasisVersion = "user basis 1";
 std::string basisInputHash(const std::string& vectorsHash, const BasisSettings& settings);
 std::string userBasisInputHash(const std::string& meshHash, const std::string& spec);
 // `source`: the recipe's name or the user basis's spec.

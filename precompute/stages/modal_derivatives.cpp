@@ -183,8 +183,7 @@ ModalDerivatives readDerivatives(const Archive& archive, const DofLayout& layout
 }
 
 std::string derivativesInputHash(const std::string& modesHash) {
-  // Version 2: residuals are normwise backward errors.
-  return InputHash().add(modesHash).add(std::string("derivatives 2")).hex();
+  return InputHash().add(modesHash).add(kDerivativesVersion).hex();
 }
 
 std::string describeDerivatives(const ModalDerivatives& derivatives) {

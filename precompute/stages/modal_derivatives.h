@@ -39,7 +39,9 @@ ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<
                                          const DofLayout& layout, const LinearModes& modes,
                                          const Eigen::MatrixXd& rigid, const DerivativeSettings& settings);
 
-// Checkpoint: group /derivatives. Input hash: the modes' and the stage's version tag.
+// Checkpoint: group /derivatives. Input hash: the modes' and the stage's version tag (2: residuals
+// are normwise backward errors).
+inline constexpr const char* kDerivativesVersion = "derivatives 2";
 std::string derivativesInputHash(const std::string& modesHash);
 void writeDerivatives(Archive& archive, const ModalDerivatives& derivatives, const DofLayout& layout,
                       const std::string& inputHash);

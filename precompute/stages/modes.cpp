@@ -201,7 +201,7 @@ LinearModes readModes(const Archive& archive, const DofLayout& layout) {
 }
 
 std::string modesInputHash(const std::string& meshHash, int count, const std::string& petscOptions) {
-  return InputHash().add(meshHash).add(count).add(petscOptions).add(std::string("modes 1")).hex();
+  return InputHash().add(meshHash).add(count).add(petscOptions).add(kModesVersion).hex();
 }
 
 std::vector<std::string> describeModes(const LinearModes& modes) {

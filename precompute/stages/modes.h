@@ -50,6 +50,7 @@ std::vector<double> eigenResiduals(Mat stiffness, Mat mass, const std::vector<do
 
 // Checkpoint: group /modes. Input hash: the mesh stage's, k, the PETSc/SLEPc options given, and the
 // stage's version tag.
+inline constexpr const char* kModesVersion = "modes 1";
 std::string modesInputHash(const std::string& meshHash, int count, const std::string& petscOptions);
 void writeModes(Archive& archive, const LinearModes& modes, const DofLayout& layout, const std::string& inputHash);
 LinearModes readModes(const Archive& archive, const DofLayout& layout);

@@ -61,7 +61,7 @@ EnergyPolynomial readPolynomial(const Archive& archive) {
 }
 
 std::string polynomialInputHash(const std::string& basisHash) {
-  return InputHash().add(basisHash).add(std::string("polynomials 1")).hex();
+  return InputHash().add(basisHash).add(kPolynomialsVersion).hex();
 }
 
 std::string describePolynomial(const EnergyPolynomial& energy, int tets, double seconds) {
