@@ -19,7 +19,8 @@ namespace quiver {
 
 class StageRunner {
 public:
-  // `archive` may be null for a runner without checkpoints; `resume` lets checkpointed stages reuse.
+  // `resume` lets checkpointed stages reuse what the archive holds. The bake opens the archive once
+  // the partition is known: checkpointed stages need setArchive first, plain ones never.
   StageRunner(const BakeContext& ctx, bool resume) : ctx_(ctx), resume_(resume) {}
   void setArchive(Archive* archive) { archive_ = archive; }
 
@@ -51,7 +52,7 @@ public:
   auto checkpointed(const char* name, const std::string& group, const std::string& inputHash, Read read,
                     Compute compute, Write write, bool& reused) {
     return run(name, [&] {
-      reused = resume_ && archive_ && storedInputHash(*archive_, group) == inputHash;
+      reused = resume_ && storedInputHash(*archive_, group) == inputHash;
       if (reused) return read(*archive_);
       auto result = compute();
       write(*archive_, result, inputHash);
