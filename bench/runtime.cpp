@@ -102,10 +102,10 @@ void Step(benchmark::State& state, const char* path, qv_solver solver) {
   if (solver == QV_SOLVER_NEWTON) config.newton_iterations = 1;
   qv_instance* s = nullptr;
   qv_instance_create(m.model, &config, nullptr, &s);
-  const double g[3] = {0, 0, -9.81};
+  const double g[3] = {0, 0, -QV_STANDARD_GRAVITY};
   qv_instance_set_gravity(s, g);
   std::vector<double> push(m.info.r, 0.0);
-  const double amplitude = 2 * 9.81 * std::fabs(qv_model_gravity(m.model)[2 * m.info.r]);
+  const double amplitude = 2 * QV_STANDARD_GRAVITY * std::fabs(qv_model_gravity(m.model)[2 * m.info.r]);
   long steps = 0, iterations = 0;
   for (auto _ : state) {
     push[0] = (steps / 30) % 2 ? amplitude : -amplitude;
@@ -131,7 +131,7 @@ void ManyObjects(benchmark::State& state, const char* path, qv_solver solver) {
   config.solver = solver;
   if (solver == QV_SOLVER_NEWTON) config.newton_iterations = 1;
   std::vector<qv_instance*> all(objects);
-  const double g[3] = {0, 0, -9.81};
+  const double g[3] = {0, 0, -QV_STANDARD_GRAVITY};
   for (auto& s : all) {
     qv_instance_create(m.model, &config, nullptr, &s);
     qv_instance_set_gravity(s, g);

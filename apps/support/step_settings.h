@@ -22,7 +22,7 @@ struct StepSettings {
 };
 
 // The gravity the tools apply (--gravity, the viewer's checkbox): m/s^2, along -z.
-inline constexpr double kGravity = 9.81;
+inline constexpr double kGravity = QV_STANDARD_GRAVITY;
 
 // The model's defaults, overridden where `settings` says.
 qv_instance_config instanceConfig(const qv_model* model, const StepSettings& settings);

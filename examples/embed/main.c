@@ -28,7 +28,7 @@ int main(int argc, char** argv) {
   config.time_step = 1.0 / 60.0; /* the game's fixed physics rate */
   qv_instance* object = NULL;
   if (qv_instance_create(model, &config, NULL, &object) != QV_OK) return 1;
-  const double gravity[3] = {0, 0, -9.81};
+  const double gravity[3] = {0, 0, -QV_STANDARD_GRAVITY};
   qv_instance_set_gravity(object, gravity);
 
   /* The renderer's vertex buffer, owned by the game. */
@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
   int handle = 0;
   for (int v = 1; v < info.vertex_count; ++v)
     if (rest[3 * v] > rest[3 * handle]) handle = v;
-  const double push[3] = {0, 0.02 * info.total_mass * 9.81, 0};
+  const double push[3] = {0, 0.02 * info.total_mass * QV_STANDARD_GRAVITY, 0};
 
   for (int frame = 0; frame < frames; ++frame) {
     if (frame < 60) qv_instance_add_vertex_force(object, handle, push);

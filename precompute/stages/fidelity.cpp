@@ -11,6 +11,7 @@
 #include "common/mass_matrix.h"
 #include "common/static_equilibrium.h"
 #include "precompute/checkpoint.h"
+#include "quiver/quiver.h"
 
 namespace quiver {
 
@@ -52,7 +53,7 @@ std::vector<std::pair<std::string, StaticLoad>> loadCases(const MeshInputs& in) 
   std::vector<std::pair<std::string, StaticLoad>> cases;
   StaticLoad weight;
   Eigen::VectorXd down = Eigen::VectorXd::Zero(n);
-  for (int v = 0; v < m.vertexCount(); ++v) down[3 * v + 2] = -9.81;
+  for (int v = 0; v < m.vertexCount(); ++v) down[3 * v + 2] = -QV_STANDARD_GRAVITY;
   weight.force = consistentMassMatrix(m, in.perTet) * down;
   cases.emplace_back(kCases[0], weight);
   const auto springs = [&](const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& move) {

@@ -89,6 +89,9 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
   work.predictorVelocity = c.take<double>(r);
   work.gradient = c.take<double>(r);
   work.trial = c.take<double>(r);
+  work.segmentEnd = c.take<double>(r);
+  work.midpointVelocity = c.take<double>(r);
+  work.stateForceSink = c.take<double>(r);
   work.pivot = c.take<int>(r);
   work.polynomialScratch = c.take<double>(quiver::rt::ReducedPolynomial::scratchSize(r));
 }

@@ -26,6 +26,9 @@ struct StepBuffers {
   double* predictorVelocity = nullptr;
   double* gradient = nullptr;     // its gradient at the current iterate
   double* trial = nullptr;        // its line search's trial point
+  double* segmentEnd = nullptr;   // the far end of the segment the energy budget bisects
+  double* midpointVelocity = nullptr;  // (v_start + v_end) / 2, for damping's share of the budget
+  double* stateForceSink = nullptr;    // where stepEnergy() lets the state forces add the force it does not need
   int* pivot = nullptr;           // LU's row exchanges
   double* polynomialScratch = nullptr;
 };

@@ -28,6 +28,9 @@ QV_API const char* qv_version_string(void);
 QV_API int qv_check_version(int version_number, size_t model_info_size, size_t instance_config_size);
 #define QV_CHECK_VERSION() qv_check_version(QV_VERSION_NUMBER, sizeof(qv_model_info), sizeof(qv_instance_config))
 
+/* Standard gravity, m/s^2: what the tools, the bake's fidelity report and the examples mean by "gravity". */
+#define QV_STANDARD_GRAVITY 9.81
+
 typedef enum qv_result {
   QV_OK = 0,
   QV_ERROR_INVALID_ARGUMENT = 1, /* a null pointer or a size that does not fit */

@@ -95,10 +95,9 @@ double stepEnergy(const qv_instance& s, const double* q, const double* v, double
     if (v) kinetic += 0.5 * v[i] * v[i];
     external += s.loads.external(i) * q[i];
   }
-  // The state forces' potential alone, their force added into a throwaway buffer: the gradient
-  // is not needed before the iteration or after it.
-  std::memset(s.work.gradient, 0, sizeof(double) * s.r);
-  s.loads.addStateForces(q, s.work.gradient, &S);
+  // The state forces' potential alone; the force they add is not needed here.
+  std::memset(s.work.stateForceSink, 0, sizeof(double) * s.r);
+  s.loads.addStateForces(q, s.work.stateForceSink, &S);
   return kinetic + elastic + S - external;
 }
 
@@ -109,11 +108,12 @@ void holdToBudget(qv_instance& s, double budget, double* x, double* velocity, do
   if (stepEnergy(s, x, nullptr, elastic) > budget) {
     // Bisection on x(t) = q + t (x - q) for the farthest t whose potential is within the budget
     // (t = 0, the start, is); 12 halvings leave t within 1/4096 of it.
-    std::memcpy(s.work.trial, x, sizeof(double) * r);  // the far end of the segment
+    double* farEnd = s.work.segmentEnd;
+    std::memcpy(farEnd, x, sizeof(double) * r);
     double within = 0, beyond = 1, withinElastic = s.elasticEnergyAtState;
     for (int cut = 0; cut < 12; ++cut) {
       const double t = 0.5 * (within + beyond);
-      for (int i = 0; i < r; ++i) x[i] = s.q[i] + t * (s.work.trial[i] - s.q[i]);
+      for (int i = 0; i < r; ++i) x[i] = s.q[i] + t * (farEnd[i] - s.q[i]);
       const double e = elasticEnergy(*s.model, s.config.elasticity, x, s.work.polynomialScratch);
       if (stepEnergy(s, x, nullptr, e) <= budget) {
         within = t;
@@ -122,7 +122,7 @@ void holdToBudget(qv_instance& s, double budget, double* x, double* velocity, do
         beyond = t;
       }
     }
-    for (int i = 0; i < r; ++i) x[i] = s.q[i] + within * (s.work.trial[i] - s.q[i]);
+    for (int i = 0; i < r; ++i) x[i] = s.q[i] + within * (farEnd[i] - s.q[i]);
     elastic = withinElastic;
     report.held_back = 1;
   }
@@ -199,8 +199,9 @@ qv_step_status minimizeStep(qv_instance& s, const StepPredictor& p) {
     elastic = trialElastic;
   }
   // Damping's share: h v_mid^T C0 v_mid, exact for the trapezoidal rule's linear damping.
-  for (int i = 0; i < r; ++i) s.work.trial[i] = 0.5 * (s.v[i] + velocity[i]);
-  for (int i = 0; i < r; ++i) budget -= p.h * s.work.trial[i] * restDampingForce(s, i, s.work.trial);
+  double* mid = s.work.midpointVelocity;
+  for (int i = 0; i < r; ++i) mid[i] = 0.5 * (s.v[i] + velocity[i]);
+  for (int i = 0; i < r; ++i) budget -= p.h * mid[i] * restDampingForce(s, i, mid);
   holdToBudget(s, budget, x, velocity, elastic, report);
   // A step held back forfeits the slack: what it removed is not to be won back.
   s.energySlack = report.held_back ? 0.0 : std::fmax(0.0, budget - stepEnergy(s, x, velocity, elastic));
