@@ -144,7 +144,7 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   const FidelityReport fidelity =
       s.fidelity.enabled ? fidelityStage(stages, ctx, in, fullU, modes, *archive) : FidelityReport{};
   const std::string qvr = stages.run("export", [&] {
-    return exportModel(ctx, s.output, in, system.mass, layout, modes, basis, fullU, energy, fidelity);
+    return exportModel(ctx, s.output, in, layout, modes, fullU, energy, fidelity);
   });
   stages.report(qvr);
 

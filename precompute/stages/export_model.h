@@ -5,12 +5,10 @@
 #include <string>
 
 #include <Eigen/Core>
-#include <petscmat.h>
 
 #include "formats/model_contents.h"
 #include "precompute/bake_context.h"
 #include "precompute/dof_layout.h"
-#include "precompute/stages/basis.h"
 #include "precompute/stages/fidelity.h"
 #include "precompute/stages/mesh.h"
 #include "precompute/stages/modes.h"
@@ -25,8 +23,8 @@ struct ExportRequest {
 };
 
 // `fullU`: the basis gathered to every rank (3n x r, vertex order). Returns the .qvr's path.
-std::string exportModel(const BakeContext& ctx, const ExportRequest& request, const MeshInputs& inputs, Mat mass,
-                        const DofLayout& layout, const LinearModes& modes, const ReducedBasis& basis,
+std::string exportModel(const BakeContext& ctx, const ExportRequest& request, const MeshInputs& inputs,
+                        const DofLayout& layout, const LinearModes& modes,
                         const Eigen::MatrixXd& fullU, const EnergyPolynomial& energy, const FidelityReport& fidelity);
 
 } // namespace quiver

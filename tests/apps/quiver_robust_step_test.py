@@ -211,5 +211,42 @@ class SpreadSpectrum(unittest.TestCase):
         self.assertEqual(json.loads(p.stdout)["resets"], 0)
 
 
+class FidelityAgainstFullSpace(unittest.TestCase):
+    """The bake's fidelity report against runs it has no part in: the full-space reference (quiver full) and
+    the runtime (quiver sim) each let a beam settle under its own weight, heavily damped, and the relative
+    difference of their rest shapes is the report's "own weight" error; the report's frequency errors are
+    the runtime's reduced frequencies against the baked ones."""
+
+    def test_own_weight_and_frequencies(self):
+        try:
+            import meshio
+        except ImportError:
+            self.skipTest("python3-meshio not installed")
+        with tempfile.TemporaryDirectory() as d:
+            mesh, out = os.path.join(d, "beam.vtu"), os.path.join(d, "beam")
+            material = ["--E", "1e8", "--nu", "0.4", "--density", "1000"]
+            run(MESH, "beam", "--size", "1,0.1,0.1", "--cells", "10,2,2", "-o", mesh)
+            run(BAKE, mesh, "--fix", "x<min+1e-9", *material, "--modes", 10, "--rank", 20, "--quiet", "-o", out)
+            info = json.loads(run(QUIVER, "info", out + ".qvr").stdout)
+            report = info["fidelity"]
+            # alpha = 64/s damps the first bending mode (32 rad/s) critically: 2 s leave e^-64 of the motion.
+            settle = ["--gravity", "--hold", 400, "--steps", 400, "--dt", 0.005, "--alpha", 64, "--beta", 0]
+            full = os.path.join(d, "full.npy")
+            run(QUIVER, "full", mesh, "--fix", "x<min+1e-9", *material, *settle, "--final-npy", full)
+            run(QUIVER, "sim", out + ".qvr", *settle, "-o", os.path.join(d, "sim"), "--every", 400)
+            u_full = np.load(full).reshape(-1, 3)
+            u_reduced = meshio.read(os.path.join(d, "sim_00400.vtu")).point_data["displacement"]
+            error = np.linalg.norm(u_reduced - u_full) / np.linalg.norm(u_full)
+            weight = report["cases"]["own weight"]
+            print(f"own weight: report {weight['displacement_error']:.4%}, quiver full vs quiver sim {error:.4%}")
+            self.assertGreater(error, 1e-5)  # a real difference to compare, not round-off
+            self.assertAlmostEqual(weight["displacement_error"] / error, 1, delta=0.05)
+            box = np.array(info["bbox"]["max"]) - np.array(info["bbox"]["min"])
+            largest = np.linalg.norm(u_full, axis=1).max() / np.linalg.norm(box)
+            self.assertAlmostEqual(weight["largest_displacement"] / largest, 1, delta=1e-3)
+            baked, reduced = np.array(info["frequencies_hz"]), np.sort(info["reduced_frequencies_hz"])
+            np.testing.assert_allclose(report["frequency_errors"], reduced[:len(baked)] / baked - 1, atol=1e-7)
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)
