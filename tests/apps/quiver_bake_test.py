@@ -110,6 +110,11 @@ class QuiverBake(unittest.TestCase):
             (["--modes", "3", "--rank", "4", "--basis", "modes", "--exact-rank"], "--rank 4 exceeds the 3 vectors"),
             (["--fix", "x>-1", "--modes", "2", "--rank", "3"], "free DOFs"),
             (["--E", "nan"], "Young's modulus E = nan"),
+            (["--nu", "nan"], "Poisson ratio nu = nan"),
+            (["--density", "nan"], "density = nan"),
+            (["--density", "-5"], "density = -5"),
+            (["--fix", "x>0.01", "--modes", "36", "--rank", "36"], "the mesh has 36 free DOFs"),  # k at the free DOFs
+            (["--fix", "x>0.01", "--modes", "5", "--rank", "37"], "the mesh has 36 free DOFs"),  # r above them
             (["--basis-from", os.path.join(self.dir, "none.npy")], "none.npy"),
             (["--basis-from", os.path.join(self.dir, "beam1.h5:/nothing")], "/nothing"),
         ]

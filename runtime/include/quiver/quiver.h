@@ -146,7 +146,7 @@ typedef enum qv_solver {
                              until the gradient is below newton_tolerance or after newton_iterations; the total
                              energy never grows within a step (what the integrator would add is taken out of the
                              velocity). No bounded load can make it run away: it resets only on non-finite input.
-                             Rayleigh damping uses the rest stiffness, C = alpha I + beta K(0). Costs about twice a
+                             Rayleigh damping uses the rest stiffness, C = alpha I + beta K(0). Costs about 3x a
                              Newton step when one iteration converges (bench/README.md). */
   QV_SOLVER_NEWTON = 1,   /* Barbic & James 2005: exactly newton_iterations Newton iterations on the equations of
                              motion, no line search, C = alpha I + beta K(q): the fastest. Safe for loads that keep
