@@ -143,8 +143,10 @@ class RobustStep(unittest.TestCase):
                           f"{after.max():.4g} J, drift over {len(after)} steps {(after[-1] - released) / released:+.2%}")
                     self.assertGreater(released, 0)
                     self.assertLessEqual(after.max(), released * (1 + 1e-5))  # the CSV prints 6 digits
-                    if integrator == "newmark":  # and keeps it: no velocity wiped to stay bounded (measured -0% / -9%)
-                        self.assertGreater(after[-1], 0.8 * released)
+                    # No lower bound here: after a 180-degree twist of a sliver mesh the energy the trapezoidal
+                    # rule trades with the budget swings widely and the phase at any one step differs between bakes.
+                    # That the budget keeps energy (wipes no velocity) is Step.UndampedNewmarkKeepsEnergyBounded...'s
+                    # lower bound, on a model of its own.
 
 
 class SpreadSpectrum(unittest.TestCase):
