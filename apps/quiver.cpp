@@ -58,12 +58,7 @@ std::vector<double> parseQ(const std::string& text, int r) {
 // The bake's fidelity report from the file's FIDELITY section (null when it has none): per load
 // case the relative displacement error and the full solution's largest displacement as a fraction
 // of the size (null: not measured), and the reduced frequencies' errors.
-ordered_json fidelityOf(const std::string& bytes) {
-  const std::vector<double> aligned((bytes.size() + 7) / 8);
-  std::memcpy(const_cast<double*>(aligned.data()), bytes.data(), bytes.size());
-  quiver::ModelView view;
-  std::string error;
-  if (!quiver::parseModel(aligned.data(), bytes.size(), view, error)) throw std::runtime_error(error);
+ordered_json fidelityOf(const quiver::ModelView& view) {
   if (!view.fidelityCaseCount && !view.fidelityFrequencyCount) return nullptr;
   const auto value = [](double x) { return std::isnan(x) ? ordered_json(nullptr) : ordered_json(x); };
   ordered_json cases = ordered_json::object();
@@ -77,6 +72,18 @@ ordered_json fidelityOf(const std::string& bytes) {
   return {{"cases", cases},
           {"frequency_errors", std::vector<double>(view.fidelityFrequencyErrors,
                                                    view.fidelityFrequencyErrors + view.fidelityFrequencyCount)}};
+}
+
+// A free object's rigid body from RIGID_BODY (null when the file has none): centre of mass and
+// inertia tensor about it, at rest.
+ordered_json rigidBodyOf(const quiver::ModelView& view) {
+  if (!view.rigidBody) return nullptr;
+  const double* S = view.rigidBody + 3;
+  const double trace = S[0] + S[4] + S[8];
+  ordered_json inertia = ordered_json::array();
+  for (int a = 0; a < 3; ++a)
+    inertia.push_back({(a == 0 ? trace : 0) - S[3 * a], (a == 1 ? trace : 0) - S[3 * a + 1], (a == 2 ? trace : 0) - S[3 * a + 2]});
+  return {{"centre_of_mass", {view.rigidBody[0], view.rigidBody[1], view.rigidBody[2]}}, {"inertia", inertia}};
 }
 
 // `quiver info`: counts, section sizes, baked and reduced frequencies, material, damping, box.
@@ -107,7 +114,13 @@ ordered_json describeModel(const quiver::app::RuntimeModel& model) {
   out["time_step"] = mi.time_step;
   out["bbox"] = {{"min", {mi.bbox_min[0], mi.bbox_min[1], mi.bbox_min[2]}},
                  {"max", {mi.bbox_max[0], mi.bbox_max[1], mi.bbox_max[2]}}};
-  out["fidelity"] = fidelityOf(bytes);
+  const std::vector<double> aligned((bytes.size() + 7) / 8);
+  std::memcpy(const_cast<double*>(aligned.data()), bytes.data(), bytes.size());
+  quiver::ModelView view;
+  std::string error;
+  if (!quiver::parseModel(aligned.data(), bytes.size(), view, error)) throw std::runtime_error(error);
+  out["fidelity"] = fidelityOf(view);
+  out["rigid_body"] = rigidBodyOf(view);
   return out;
 }
 

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "common/modal_rotation.h"
+#include "common/rigid_body.h"
 #include "common/surface.h"
 
 namespace quiver {
@@ -73,6 +74,17 @@ ModelContents makeModelContents(const CheckedMesh& mesh, const std::vector<Mater
   c.rotations.resize(psi.size());
   for (Eigen::Index i = 0; i < psi.rows(); ++i)
     for (int j = 0; j < r; ++j) c.rotations[i * r + j] = psi(i, j);
+  if (settings.rigidBody) {
+    const RigidBodyMoments rb = rigidBodyMoments(m, perTet, basis);
+    c.rigidBody.assign(rb.centre.data(), rb.centre.data() + 3);
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) c.rigidBody.push_back(rb.secondMoment(a, b));
+    for (int ab = 0; ab < 9; ++ab)
+      for (int j = 0; j < r; ++j) c.rigidBody.push_back(rb.first(ab, j));
+    for (int ab = 0; ab < 9; ++ab)
+      for (int j = 0; j < r; ++j)
+        for (int k = 0; k < r; ++k) c.rigidBody.push_back(rb.second[ab](j, k));
+  }
   return c;
 }
 

@@ -17,6 +17,7 @@ struct ExportSettings {
   int basisPrecision = 32;   // bits per stored basis entry: 32 (default, half the size) or 64
   double dampingRatio = 0.02;  // default Rayleigh damping: this fraction of critical at the first mode (stiffness-proportional)
   double timeStep = 1.0 / 60;  // suggested time step, s
+  bool rigidBody = false;      // a free object: store its mass moments (RIGID_BODY) for flight
 };
 
 // `basis`: full 3n x r in vertex order; `energy`: the ENERGY_COEFFICIENTS of that basis (see

@@ -41,8 +41,13 @@ enum SectionType : uint32_t {
   kTets = 9,             // optional: readers need not have it
   kModalRotations = 10,  // optional (written with the optional flag, so 1.0 readers skip it)
   kFidelity = 11,        // optional, likewise: the bake's fidelity report
+  kRigidBody = 12,       // optional, likewise: a free object's mass moments (common/rigid_body.h)
 };
-constexpr uint32_t kLastKnownType = kFidelity;
+constexpr uint32_t kLastKnownType = kRigidBody;
+// RIGID_BODY: f64 centre of mass c (3), second moments S0 about c (3 x 3, row-major), first
+// moments B (9 x r, row 3a + b) and second moments A of the basis (9 blocks of r x r, block
+// 3a + b, row-major): rigidBodySize(r) values.
+constexpr size_t rigidBodySize(uint64_t r) { return static_cast<size_t>(12 + 9 * r + 9 * r * r); }
 
 // FIDELITY: u32 case count c (<= kMaxFidelityCases), u32 frequency count f (<= the eigenvalue
 // count), c records of kFidelityRecordSize bytes (a NUL-padded ASCII name of kFidelityNameSize
@@ -148,6 +153,7 @@ struct ModelView {
   uint32_t fidelityCaseCount = 0, fidelityFrequencyCount = 0;
   const unsigned char* fidelityCases = nullptr;
   const double* fidelityFrequencyErrors = nullptr;
+  const double* rigidBody = nullptr;        // rigidBodySize(r) values (see RIGID_BODY); null when the file has none
 };
 
 // Validates the .qvr file held in `data` (the whole file, `size` bytes, 8-byte aligned as malloc,

@@ -22,7 +22,7 @@ static_assert(std::numeric_limits<float>::is_iec559 && sizeof(float) == 4, "floa
 std::string qvr::sectionName(uint32_t type) {
   static const char* const kNames[] = {"", "MODEL_INFO", "ENERGY_COEFFICIENTS", "BASIS", "REST_POSITIONS",
                                        "SURFACE_TRIANGLES", "VERTEX_MAP", "GRAVITY_PROJECTION", "EIGENVALUES", "TETS",
-                                       "MODAL_ROTATIONS", "FIDELITY"};
+                                       "MODAL_ROTATIONS", "FIDELITY", "RIGID_BODY"};
   static_assert(std::size(kNames) == kLastKnownType + 1, "one name for every known section type");
   return type >= 1 && type <= kLastKnownType ? kNames[type] : "section type " + std::to_string(type);
 }
@@ -179,7 +179,8 @@ private:
       if (!checkSection(s)) return false;
     }
     for (uint32_t type = kModelInfo; type <= kLastKnownType; ++type)
-      if (!byType_[type] && type != kTets && type != kModalRotations && type != kFidelity)
+      if (!byType_[type] && type != kTets && type != kModalRotations && type != kFidelity &&
+          type != kRigidBody)
         return fail("missing required section " + sectionName(type));
     return true;
   }
@@ -305,6 +306,28 @@ private:
     return true;
   }
 
+  // RIGID_BODY: finite values, the centre inside the bounding box, second moments symmetric with a
+  // positive diagonal (a body with mass along every axis).
+  bool rigidBody(ModelView& view) {
+    const Section& s = *byType_[kRigidBody];
+    const double* values = nullptr;
+    if (!floats(kRigidBody, rigidBodySize(view.info.r), std::to_string(rigidBodySize(view.info.r)) + " values (r = " +
+                                                             std::to_string(view.info.r) + ")", values))
+      return false;
+    double v[12];
+    for (int i = 0; i < 12; ++i) v[i] = loadF64(data_ + s.offset + 8 * i);
+    for (int a = 0; a < 3; ++a)
+      if (!(v[a] >= view.info.bboxMin[a] && v[a] <= view.info.bboxMax[a]))
+        return failIn(s, "the centre of mass lies outside the bounding box");
+    for (int a = 0; a < 3; ++a) {
+      if (!(v[3 + 4 * a] > 0)) return failIn(s, "second moment " + std::to_string(a) + std::to_string(a) + " is not positive");
+      for (int b = 0; b < a; ++b)
+        if (v[3 + 3 * a + b] != v[3 + 3 * b + a]) return failIn(s, "the second moments are not symmetric");
+    }
+    view.rigidBody = values;
+    return true;
+  }
+
   // FIDELITY: counts in range, the size they imply, printable NUL-terminated names, values finite
   // (case values may also be NaN: not measured).
   bool fidelity(const Section& s, uint32_t eigenvalueCount, ModelView& view) {
@@ -400,6 +423,7 @@ private:
         !floats(kModalRotations, 3 * n * r, "3 x " + vertices + " x " + rText, view.rotations))
       return false;
     if (byType_[kFidelity] && !fidelity(*byType_[kFidelity], info.eigenvalueCount, view)) return false;
+    if (byType_[kRigidBody] && !rigidBody(view)) return false;
     if (!byType_[kTets]) return true;
     return indices(*byType_[kTets], info.tetCount, 4, "4 x " + std::to_string(info.tetCount) + " tets",
                    info.vertexCount, "vertexCount", view.tets);

@@ -92,6 +92,7 @@ std::string formatModel(const ModelContents& c) {
                                piece(kEigenvalues, c.eigenvalues)};
   if (!c.tets.empty()) pieces.push_back(piece(kTets, c.tets));
   if (!c.rotations.empty()) pieces.push_back(piece(kModalRotations, c.rotations, kOptionalSection));
+  if (!c.rigidBody.empty()) pieces.push_back(piece(kRigidBody, c.rigidBody, kOptionalSection));
   std::vector<unsigned char> fidelity;
   if (!c.fidelityCases.empty() || !c.fidelityFrequencyErrors.empty()) {
     fidelity.assign(8 + c.fidelityCases.size() * kFidelityRecordSize + 8 * c.fidelityFrequencyErrors.size(), 0);
@@ -181,6 +182,7 @@ ModelContents copyModel(const ModelView& view) {
     c.fidelityCases.push_back(fc);
   }
   c.fidelityFrequencyErrors.assign(view.fidelityFrequencyErrors, view.fidelityFrequencyErrors + view.fidelityFrequencyCount);
+  if (view.rigidBody) c.rigidBody.assign(view.rigidBody, view.rigidBody + rigidBodySize(r));
   return c;
 }
 

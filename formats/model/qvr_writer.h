@@ -28,6 +28,7 @@ struct ModelContents {
   };
   std::vector<FidelityCase> fidelityCases;
   std::vector<double> fidelityFrequencyErrors;
+  std::vector<double> rigidBody;      // rigidBodySize(r) values (see ModelView), or empty to leave them out
 };
 
 // The ENERGY_COEFFICIENTS of q^T A2 q + 2 q^T A3 z + z^T A4 z (z the products q_j q_k, j <= k, in

@@ -29,8 +29,10 @@ std::string exportModel(const BakeContext& ctx, const ExportRequest& request, co
   Eigen::MatrixXd axes = Eigen::MatrixXd::Zero(wholeMass.rows(), 3);
   for (Eigen::Index i = 0; i < axes.rows(); ++i) axes(i, i % 3) = 1;
   const Eigen::MatrixXd gravity = fullU.transpose() * (wholeMass * axes);
+  ExportSettings settings = request.model;
+  settings.rigidBody = in.freeObject();  // what a free object needs to fly
   ModelContents contents =
-      makeModelContents(in.mesh, in.perTet, fullU, energy.coefficients, modes.eigenvalues, gravity, request.model);
+      makeModelContents(in.mesh, in.perTet, fullU, energy.coefficients, modes.eigenvalues, gravity, settings);
   for (const FidelityCase& c : fidelity.cases)
     contents.fidelityCases.push_back({c.name, c.error, c.largestDisplacement});
   contents.fidelityFrequencyErrors = fidelity.frequencyErrors;

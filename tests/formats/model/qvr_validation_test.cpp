@@ -278,3 +278,39 @@ TEST(QvrValidation, TheFidelityReportRoundTripsAndIsChecked) {
 }
 
 } // namespace quiver
+
+namespace quiver {
+namespace {
+
+// The RIGID_BODY section: a free object's mass moments round-trip and are checked: the size r
+// implies, finite values, the centre inside the box, symmetric second moments with mass along
+// every axis.
+TEST(QvrValidation, TheRigidBodyRoundTripsAndIsChecked) {
+  ModelContents c = test::syntheticModel();
+  const size_t r = c.info.r;
+  c.rigidBody.assign(qvr::rigidBodySize(r), 0.25);
+  for (int a = 0; a < 3; ++a) c.rigidBody[a] = 0.5 * (c.info.bboxMin[a] + c.info.bboxMax[a]);
+  for (int ab = 0; ab < 9; ++ab) c.rigidBody[3 + ab] = ab % 4 == 0 ? 2.0 : 0.125;  // S0: diagonal 2, the rest 1/8
+  const std::string f = formatModel(c);
+  {
+    test::AlignedFile file(f);
+    ModelView view;
+    std::string error;
+    ASSERT_TRUE(file.parse(view, error)) << error;
+    ASSERT_NE(view.rigidBody, nullptr);
+    EXPECT_EQ(copyModel(view).rigidBody, c.rigidBody);
+  }
+  const uint64_t count = test::getLE(f, 20, 4);
+  const size_t at = test::getLE(f, entry(count - 1) + 8, 8);
+  ASSERT_EQ(test::getLE(f, entry(count - 1), 4), uint64_t{qvr::kRigidBody});
+  const std::string section = "RIGID_BODY at byte " + std::to_string(at) + ": ";
+  EXPECT_REFUSED(patched(f, at + 8 * 20, test::bitsOf(kNaN), 8), section + "value 20 (byte " + std::to_string(at + 160) + ") is not finite");
+  EXPECT_REFUSED(patched(f, at, test::bitsOf(c.info.bboxMax[0] + 1), 8), section + "the centre of mass lies outside the bounding box");
+  EXPECT_REFUSED(patched(f, at + 8 * 7, test::bitsOf(-1.0), 8), section + "second moment 11 is not positive");
+  EXPECT_REFUSED(patched(f, at + 8 * 4, test::bitsOf(0.5), 8), section + "the second moments are not symmetric");
+  c.rigidBody.pop_back();
+  EXPECT_THROW(formatModel(c), std::runtime_error);
+}
+
+} // namespace
+} // namespace quiver
