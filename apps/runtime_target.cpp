@@ -1,6 +1,7 @@
 #include "apps/runtime_target.h"
 
 #include <iostream>
+#include <stdexcept>
 
 namespace quiver::app {
 
@@ -14,6 +15,18 @@ RuntimeTarget::RuntimeTarget(const RuntimeModel& model, const StepSettings& sett
 
 void RuntimeTarget::addVertexForce(int vertex, const double force[3]) {
   qv_instance_add_vertex_force(instance_.get(), vertex, force);
+}
+
+void RuntimeTarget::startFlight(const SimOptions& o) {
+  qv_rigid_state state;
+  qv_instance_get_rigid_state(instance_.get(), &state);  // the pose as baked
+  for (int a = 0; a < 3; ++a) {
+    state.position[a] += o.position[a];
+    state.linear_velocity[a] = o.velocity[a];
+    state.angular_velocity[a] = o.angularVelocity[a];
+  }
+  if (qv_instance_set_rigid_state(instance_.get(), &state) != QV_OK)
+    throw std::runtime_error("--position, --velocity and --angular-velocity must be finite");
 }
 
 void RuntimeTarget::setGravity(const double g[3]) { qv_instance_set_gravity(instance_.get(), g); }

@@ -13,6 +13,7 @@ public:
   RuntimeTarget(RuntimeModel&&, const StepSettings&) = delete;  // kept by reference
   void addVertexForce(int vertex, const double force[3]) override;
   void setGravity(const double acceleration[3]) override;
+  void startFlight(const SimOptions& options) override;
   void setSprings(const std::vector<int>& vertices, const std::vector<double>& targets, double stiffness) override;
   void clearSprings() override;
   int step(int& newtonIterations) override;

@@ -18,6 +18,9 @@ public:
       : sim_(mesh, perTet, fixed, settings), timeStep_(settings.timeStep) {}
   void addVertexForce(int vertex, const double f[3]) override { sim_.addVertexForce(vertex, Eigen::Vector3d(f[0], f[1], f[2])); }
   void setGravity(const double g[3]) override { sim_.setGravity(Eigen::Vector3d(g[0], g[1], g[2])); }
+  void startFlight(const SimOptions&) override {
+    throw std::runtime_error("--free: the full-space reference simulates pinned objects only");
+  }
   void setSprings(const std::vector<int>& vertices, const std::vector<double>& targets, double stiffness) override {
     std::vector<Eigen::Vector3d> points;
     for (size_t k = 0; k < vertices.size(); ++k) points.emplace_back(targets[3 * k], targets[3 * k + 1], targets[3 * k + 2]);

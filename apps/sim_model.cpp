@@ -1,4 +1,5 @@
 // `quiver sim`: the scenario on the runtime library, as a game would drive it.
+#include <cmath>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
@@ -30,6 +31,12 @@ int simulateModel(const std::string& path, const SimOptions& o) {
     j["newton_iterations_mean"] = static_cast<double>(result.newtonIterations) / o.steps;
     j["held_back_steps"] = target.heldBackSteps();
     j["energy_removed_J"] = target.energyRemoved();
+    qv_rigid_state flight;
+    if (qv_instance_get_rigid_state(target.instance().get(), &flight) == QV_OK) {
+      const double* v = flight.linear_velocity;
+      j["final_center"] = {flight.position[0], flight.position[1], flight.position[2]};  // world centre of mass, m
+      j["final_speed_mps"] = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    }
     std::cout << j.dump(1) << "\n";
   } else {
     std::cout << "quiver sim: " << o.steps << " steps of r = " << model.info().r << ": median " << median << " us, p99 "

@@ -28,6 +28,12 @@ void SimOptions::addScenarioTo(CLI::App& app) {
       ->check(CLI::IsMember({"x", "y", "z"}));
   app.add_option("--stiffness", stiffness, "Drag: penalty spring per vertex, N/m")->capture_default_str();
   app.add_flag("--gravity", gravity, "Gravity, 9.81 m/s^2 along -z");
+  app.add_flag("--free", step.freeFlight, "Fly: rigid motion with the deformation (a model baked with no fixed vertex)");
+  app.add_option("--position", position, "Free flight: start translated by x,y,z (m) from where the model was baked")
+      ->delimiter(',')->expected(3);
+  app.add_option("--velocity", velocity, "Free flight: initial velocity vx,vy,vz, m/s")->delimiter(',')->expected(3);
+  app.add_option("--angular-velocity", angularVelocity, "Free flight: initial spin wx,wy,wz, rad/s (world axes)")
+      ->delimiter(',')->expected(3);
   app.add_option("--dt", step.timeStep, "Time step, s")->check(Positive);
   app.add_option("--newton", step.newton,
                  "Newton iterations per implicit step: the most (--solver minimize, default 8; full space, default 20) "
@@ -90,6 +96,10 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
                            const std::function<void(int)>& afterStep) {
   const std::vector<int> group = selectGroup(mesh, o.group);
   const bool dragMode = o.twist != 0 || o.drag != std::vector<double>{0, 0, 0};
+  const std::vector<double> none{0, 0, 0};
+  if (!o.step.freeFlight && (o.position != none || o.velocity != none || o.angularVelocity != none))
+    throw std::runtime_error("--position, --velocity and --angular-velocity need --free");
+  if (o.step.freeFlight) target.startFlight(o);
   if (o.gravity) {
     const double g[3] = {0, 0, -kGravity};
     target.setGravity(g);

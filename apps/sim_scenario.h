@@ -24,6 +24,10 @@ struct SimOptions {
   std::string axis = "x";               // x | y | z: the twist axis
   double stiffness = 1e4;               // N/m per vertex, drag mode's penalty springs
   bool gravity = false;                 // add g = 9.81 m/s^2 along -z
+  // Free flight (--free, step.freeFlight): where and how the object starts, in the world.
+  std::vector<double> position{0, 0, 0};         // m, the model translated from where it was baked
+  std::vector<double> velocity{0, 0, 0};         // m/s
+  std::vector<double> angularVelocity{0, 0, 0};  // rad/s, about the centre of mass
   StepSettings step;                    // integrator, elasticity, time step, Newton iterations per step
                                         // (runtime; full space: at most), Rayleigh damping
   std::string output;                   // NAME: NAME.pvd, NAME_NNNNN.vtu, NAME.csv; "" for none
@@ -47,6 +51,8 @@ public:
   virtual ~ScenarioTarget() = default;
   virtual void addVertexForce(int vertex, const double force[3]) = 0;
   virtual void setGravity(const double acceleration[3]) = 0;
+  // Free flight from the options' position, velocity and angular velocity; throws where the target cannot fly.
+  virtual void startFlight(const SimOptions& options) = 0;
   virtual void setSprings(const std::vector<int>& vertices, const std::vector<double>& targets, double stiffness) = 0;
   virtual void clearSprings() = 0;
   // Advances one step; returns a status for the CSV (0 ok) and counts Newton iterations.

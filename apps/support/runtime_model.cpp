@@ -49,6 +49,8 @@ RuntimeInstance::RuntimeInstance(const RuntimeModel& model, const qv_instance_co
   if (qv_instance_create(model.get(), &config_, nullptr, &instance_) != QV_OK)
     throw std::runtime_error(config_.elasticity == QV_ELASTICITY_MODAL_WARPING && !model.info().has_modal_rotations
                                  ? model.path() + " has no modal rotations (bake it again for modal warping)"
+                             : config_.free_flight && !model.info().has_rigid_body
+                                 ? model.path() + " was baked with fixed vertices: only a model baked free (no --fix) can fly"
                                  : "invalid simulation settings (time step, Newton iterations, damping)");
 }
 

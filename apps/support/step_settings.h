@@ -17,6 +17,7 @@ struct StepSettings {
   int newton = 0;                // Newton iterations per implicit step (the most, or exactly: qv_solver); 0: the runtime's default
   qv_solver solver = QV_SOLVER_MINIMIZE;
   double alpha = -1, beta = -1;  // Rayleigh damping; negative: the model's
+  bool freeFlight = false;       // the object flies (a model baked free): qv_instance_config::free_flight
 
   bool operator==(const StepSettings& o) const;
 };

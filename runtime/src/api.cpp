@@ -1,6 +1,7 @@
 // The C API: argument checks, then one call into the runtime's parts (model, instance, loads,
 // integrators, elasticity, output). Nothing here computes.
 #include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -258,7 +259,7 @@ void qv_instance_last_step(const qv_instance* s, qv_step_report* report) {
 
 qv_result qv_instance_add_vertex_force(qv_instance* s, int vertex, const double force[3]) {
   if (!s || !force || !validVertex(s, vertex)) return QV_ERROR_INVALID_ARGUMENT;
-  s->loads.addVertexForce(*s->model, s->config.elasticity, s->q, vertex, force);
+  s->addVertexForce(vertex, force);
   return QV_OK;
 }
 
@@ -269,12 +270,12 @@ qv_result qv_instance_add_reduced_force(qv_instance* s, const double* force) {
 }
 
 void qv_instance_set_gravity(qv_instance* s, const double g[3]) {
-  if (s && g) s->loads.setGravity(*s->model, g);
+  if (s && g) s->setGravity(g);
 }
 
 qv_result qv_instance_set_constraint(qv_instance* s, int slot, const int* vertices, int count, const double* targets,
                                      double stiffness) {
-  if (!s || slot < 0 || slot >= s->config.max_constraints || count < 1 || !vertices || !targets || !(stiffness > 0) ||
+  if (!s || s->flying() || slot < 0 || slot >= s->config.max_constraints || count < 1 || !vertices || !targets || !(stiffness > 0) ||
       !validVertices(s, vertices, count))
     return QV_ERROR_INVALID_ARGUMENT;
   s->loads.setConstraint(*s->model, slot, vertices, count, targets, stiffness);
@@ -314,6 +315,37 @@ void qv_instance_reset(qv_instance* s) {
 
 void qv_instance_energies(const qv_instance* s, double* kinetic, double* elastic) {
   if (s) s->energies(kinetic, elastic);
+}
+
+qv_result qv_instance_get_rigid_state(const qv_instance* s, qv_rigid_state* state) {
+  if (!s || !state || !s->flying()) return QV_ERROR_INVALID_ARGUMENT;
+  quiver::rt::RigidFrame f = s->frame;  // refreshed on the side: a query changes no state
+  f.refresh(*s->model, s->q, s->v);
+  std::memcpy(state->position, f.position, sizeof state->position);
+  std::memcpy(state->orientation, f.orientation, sizeof state->orientation);
+  std::memcpy(state->linear_velocity, f.velocity, sizeof state->linear_velocity);
+  f.worldOmega(state->angular_velocity);
+  return QV_OK;
+}
+
+qv_result qv_instance_set_rigid_state(qv_instance* s, const qv_rigid_state* state) {
+  if (!s || !state || !s->flying()) return QV_ERROR_INVALID_ARGUMENT;
+  double norm = 0;
+  for (double w : state->orientation) norm += w * w;
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(state->position[a]) || !std::isfinite(state->linear_velocity[a]) ||
+        !std::isfinite(state->angular_velocity[a]))
+      return QV_ERROR_INVALID_ARGUMENT;
+  if (!(norm > 0) || !std::isfinite(norm)) return QV_ERROR_INVALID_ARGUMENT;
+  quiver::rt::RigidFrame& f = s->frame;
+  std::memcpy(f.position, state->position, sizeof f.position);
+  f.setOrientation(state->orientation);
+  std::memcpy(f.velocity, state->linear_velocity, sizeof f.velocity);
+  std::memcpy(f.homePosition, f.position, sizeof f.homePosition);
+  std::memcpy(f.homeOrientation, f.orientation, sizeof f.homeOrientation);
+  f.refresh(*s->model, s->q, s->v);
+  f.setWorldOmega(state->angular_velocity);
+  return QV_OK;
 }
 
 double qv_instance_stable_time_step(const qv_instance* s) { return s ? s->model->stableStep : 0; }

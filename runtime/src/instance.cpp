@@ -17,7 +17,8 @@ bool validConfig(const qv_model* model, const qv_instance_config* c) {
          c->elasticity >= 0 &&
          c->elasticity < QV_ELASTICITY_COUNT && (!kElasticities[c->elasticity].needsRotations || model->rotations) &&
          c->time_step > 0 && std::isfinite(c->time_step) && c->newton_iterations >= 1 && c->rayleigh_alpha >= 0 &&
-         c->rayleigh_beta >= 0 && c->max_constraints >= 0 && c->max_constraints <= 64 && c->max_displacement > 0;
+         c->rayleigh_beta >= 0 && c->max_constraints >= 0 && c->max_constraints <= 64 && c->max_displacement > 0 &&
+         (c->free_flight == 0 || (c->free_flight == 1 && model->rigidBody));
 }
 
 void defaultConfig(qv_instance_config& config, const qv_model* model) {
@@ -37,6 +38,7 @@ void defaultConfig(qv_instance_config& config, const qv_model* model) {
   }
   config.max_displacement = 100.0 * diagonal;
   config.elasticity = QV_ELASTICITY_STVK;
+  config.free_flight = 0;
 }
 
 size_t instanceBytes(const qv_model& model, const qv_instance_config& config) {
@@ -65,6 +67,11 @@ qv_instance* constructInstance(const qv_model& model, const qv_instance_config& 
   }
   s->maxQ = rowNorm > 0 ? config.max_displacement / rowNorm : config.max_displacement;
   s->loads.clear();
+  if (s->flying()) {
+    std::memcpy(s->frame.homePosition, model.rigidBody, sizeof s->frame.homePosition);  // as baked
+    s->loads.frame = &s->frame;
+    s->loads.model = &model;
+  }
   s->rest();
   return s;
 }
@@ -76,7 +83,7 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
   q = c.take<double>(r);
   v = c.take<double>(r);
   a = c.take<double>(r);
-  loads.carve(c, r, config.max_constraints);
+  loads.carve(c, r, config.max_constraints, flying());
   end.q = c.take<double>(r);
   end.v = c.take<double>(r);
   end.a = c.take<double>(r);
@@ -94,6 +101,7 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
   work.stateForceSink = c.take<double>(r);
   work.pivot = c.take<int>(r);
   work.polynomialScratch = c.take<double>(quiver::rt::ReducedPolynomial::scratchSize(r));
+  if (flying()) frame.attach(c.take<double>(quiver::rt::RigidFrame::scratchDoubles(r)), r);
 }
 
 void qv_instance::rest() {
@@ -102,6 +110,7 @@ void qv_instance::rest() {
   std::memset(a, 0, sizeof(double) * r);
   elasticEnergyAtState = 0;
   energySlack = 0;
+  if (flying()) frame.goHome();
 }
 
 bool qv_instance::healthy() const {
@@ -110,11 +119,59 @@ bool qv_instance::healthy() const {
   for (int i = 0; i < r; ++i)
     if (!(bounded ? std::isfinite(q[i]) : std::fabs(q[i]) <= maxQ) || !std::isfinite(v[i]) || !std::isfinite(a[i]))
       return false;
-  return true;
+  return !flying() || frame.finite();
+}
+
+void qv_instance::addVertexForce(int vertex, const double force[3]) {
+  if (!flying()) {
+    loads.addVertexForce(*model, config.elasticity, q, vertex, force);
+    return;
+  }
+  // On the frame: the force, and its torque about the centre of mass from where the vertex is.
+  double u[3], p[3], world[3], body[3];
+  model->vertexLinear(vertex, q, u, nullptr);
+  for (int c = 0; c < 3; ++c) p[c] = model->rest[3 * vertex + c] - model->rigidBody[c] + u[c];
+  frame.toWorld(p, world);
+  const double* x = frame.position;
+  const double arm[3] = {world[0] - x[0], world[1] - x[1], world[2] - x[2]};
+  frame.torque[0] += arm[1] * force[2] - arm[2] * force[1];
+  frame.torque[1] += arm[2] * force[0] - arm[0] * force[2];
+  frame.torque[2] += arm[0] * force[1] - arm[1] * force[0];
+  for (int c = 0; c < 3; ++c) frame.force[c] += force[c];
+  // On q: the force seen from the body.
+  frame.toBody(force, body);
+  loads.addVertexForce(*model, config.elasticity, q, vertex, body);
+}
+
+void qv_instance::setGravity(const double g[3]) {
+  if (!flying()) {
+    loads.setGravity(*model, g);
+    return;
+  }
+  // A uniform field accelerates the frame and everything in it alike: nothing of it deforms q.
+  std::memcpy(frame.gravity, g, sizeof frame.gravity);
+  loads.changed = true;
+}
+
+void qv_instance::beginFlight() {
+  const double h = config.time_step;
+  frame.refresh(*model, q, v);
+  frame.holdSpin();
+  std::memset(loads.frameForce, 0, sizeof(double) * r);
+  frame.addInertialForces(*model, h, loads.frameForce);
+  // The frame's acceleration beyond gravity, -G R^T F / m, which q feels through G = U^T M e_a
+  // (zero for a free bake's basis, which carries no momentum).
+  double accel[3], body[3];
+  for (int c = 0; c < 3; ++c) accel[c] = -frame.force[c] / model->info.total_mass;
+  frame.toBody(accel, body);
+  for (int j = 0; j < r; ++j)
+    loads.frameForce[j] += model->gravity[j] * body[0] + model->gravity[r + j] * body[1] + model->gravity[2 * r + j] * body[2];
+  frame.advance(*model, h);
 }
 
 qv_step_status qv_instance::step() {
   lastStep = qv_step_report{};
+  if (flying()) beginFlight();
   const qv_step_status status = quiver::rt::kIntegrators[config.integrator].step(*this);
   loads.endStep();
   if (status == QV_STEP_RESET || !healthy()) {
@@ -146,6 +203,14 @@ void qv_instance::saveSnapshot(double* out) const {
   std::memcpy(out + 1 + 2 * r, a, sizeof(double) * r);
   out[1 + 3 * r] = elasticEnergyAtState;
   out[2 + 3 * r] = energySlack;
+  if (flying()) {
+    double* f = out + 3 + 3 * r;
+    std::memcpy(f, frame.position, 3 * sizeof(double));
+    std::memcpy(f + 3, frame.orientation, 4 * sizeof(double));
+    std::memcpy(f + 7, frame.velocity, 3 * sizeof(double));
+    std::memcpy(f + 10, frame.angularMomentum, 3 * sizeof(double));
+    std::memcpy(f + 13, frame.lastBodyOmega, 3 * sizeof(double));
+  }
 }
 
 bool qv_instance::restoreSnapshot(const double* in) {
@@ -155,6 +220,14 @@ bool qv_instance::restoreSnapshot(const double* in) {
   std::memcpy(a, in + 1 + 2 * r, sizeof(double) * r);
   elasticEnergyAtState = in[1 + 3 * r];
   energySlack = in[2 + 3 * r];
+  if (flying()) {
+    const double* f = in + 3 + 3 * r;
+    std::memcpy(frame.position, f, 3 * sizeof(double));
+    frame.setOrientation(f + 3);
+    std::memcpy(frame.velocity, f + 7, 3 * sizeof(double));
+    std::memcpy(frame.angularMomentum, f + 10, 3 * sizeof(double));
+    std::memcpy(frame.lastBodyOmega, f + 13, 3 * sizeof(double));
+  }
   return true;
 }
 
@@ -162,6 +235,11 @@ void qv_instance::energies(double* kinetic, double* elastic) const {
   if (kinetic) {
     double k = 0;
     for (int i = 0; i < r; ++i) k += 0.5 * v[i] * v[i];
+    if (flying()) {
+      quiver::rt::RigidFrame f = frame;  // refreshed on the side: energies() changes no state
+      f.refresh(*model, q, v);
+      k += f.kineticEnergy(*model);
+    }
     *kinetic = k;
   }
   if (elastic) *elastic = quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);

@@ -4,6 +4,7 @@
 #include "block_carver.h"
 #include "loads.h"
 #include "model.h"
+#include "rigid_frame.h"
 
 namespace quiver::rt {
 
@@ -56,6 +57,7 @@ struct qv_instance {
   quiver::rt::Loads loads;
   quiver::rt::EndOfStep end;
   quiver::rt::StepBuffers work;
+  quiver::rt::RigidFrame frame;  // in flight (config.free_flight) only
 
   void carve(quiver::rt::BlockCarver& c);
   void rest();
@@ -63,8 +65,14 @@ struct qv_instance {
   // One step of the configured integrator; per-step loads are spent; a blown-up state resets.
   qv_step_status step();
   void setState(const double* q, const double* v, const double* a);
-  // The snapshot: r, then q, v, a, E(q) and the energy slack, as doubles.
-  size_t snapshotSize() const { return sizeof(double) * (3 * static_cast<size_t>(r) + 3); }
+  bool flying() const { return config.free_flight != 0; }
+  // A world force on a vertex: on q (and, in flight, on the frame).
+  void addVertexForce(int vertex, const double force[3]);
+  void setGravity(const double acceleration[3]);
+  void beginFlight();  // in flight, before the integrator: the frame's forces on q, then the frame's step
+  // The snapshot: r, then q, v, a, E(q) and the energy slack, then in flight the frame (position,
+  // orientation, velocity, angular momentum, last body omega), as doubles.
+  size_t snapshotSize() const { return sizeof(double) * (3 * static_cast<size_t>(r) + 3 + (flying() ? 16 : 0)); }
   void saveSnapshot(double* out) const;
   bool restoreSnapshot(const double* in);
   void energies(double* kinetic, double* elastic) const;

@@ -6,24 +6,27 @@
 
 namespace quiver::rt {
 
-void Loads::carve(BlockCarver& c, int reducedSize, int slotCount) {
+void Loads::carve(BlockCarver& c, int reducedSize, int slotCount, bool flying) {
   r = reducedSize;
   slots = slotCount;
   const size_t rr = static_cast<size_t>(r) * r;
   stepForce = c.take<double>(r);
   lastStepForce = c.take<double>(r);
   gravityForce = c.take<double>(r);
+  frameForce = c.take<double>(r);
   constraintK = c.take<double>(rr);
   constraintB = c.take<double>(r);
   slotK = c.take<double>(rr * slots);
   slotB = c.take<double>(static_cast<size_t>(r) * slots);
   slotActive = c.take<int>(slots);
+  if (flying) stateJacobian = c.take<double>(rr);
 }
 
 void Loads::clear() {
   std::memset(stepForce, 0, sizeof(double) * r);
   std::memset(lastStepForce, 0, sizeof(double) * r);
   std::memset(gravityForce, 0, sizeof(double) * r);
+  std::memset(frameForce, 0, sizeof(double) * r);
   std::memset(slotActive, 0, sizeof(int) * slots);
   combineConstraints();
 }
@@ -36,8 +39,14 @@ const double* Loads::addStateForces(const double* q, double* force, double* ener
     force[i] += s;
     potential += 0.5 * q[i] * (s - constraintB[i]);
   }
+  if (!frame) {
+    if (energy) *energy = potential;
+    return constraintK;
+  }
+  std::memcpy(stateJacobian, constraintK, sizeof(double) * r * r);
+  potential += frame->addCentrifugal(*model, q, force, stateJacobian);
   if (energy) *energy = potential;
-  return constraintK;
+  return stateJacobian;
 }
 
 void Loads::endStep() {

@@ -13,8 +13,10 @@
 // the active slots and is returned as it is. A term whose Jacobian depends on q (contact) writes
 // that sum plus its own into a buffer it owns and returns the buffer; a term that also depends on
 // the velocity (contact damping, friction) adds its velocity Jacobian to the c1 part of the system.
+// In flight the frame's centrifugal potential (rigid_frame.h) is such a term.
 #include "block_carver.h"
 #include "model.h"
+#include "rigid_frame.h"
 
 namespace quiver::rt {
 
@@ -23,6 +25,8 @@ struct Loads {
   int slots = 0;
   double* stepForce = nullptr;     // this step's only
   double* gravityForce = nullptr;  // G g
+  double* frameForce = nullptr;    // in flight, the moving frame's forces on q this step (zero otherwise): they
+                                   // follow the motion, so they are no change of load (changedSinceLastStep)
   double* constraintK = nullptr;   // sum over active slots of k U_v^T U_v
   double* constraintB = nullptr;   // sum over active slots of k U_v^T (target - X_v)
   double* slotK = nullptr;         // per slot
@@ -30,12 +34,15 @@ struct Loads {
   int* slotActive = nullptr;
   double* lastStepForce = nullptr; // the per-step forces of the step before
   bool changed = false;            // a persistent load was set since the last step
+  const RigidFrame* frame = nullptr;  // in flight: its centrifugal potential is a state force
+  const qv_model* model = nullptr;    // with it, the model the frame carries
+  double* stateJacobian = nullptr;    // in flight: the constraints' Jacobian plus the centrifugal one
 
   // Takes the arrays from `c` (null pointers while it measures).
-  void carve(BlockCarver& c, int reducedSize, int slotCount);
+  void carve(BlockCarver& c, int reducedSize, int slotCount, bool flying);
   void clear();  // nothing acting
 
-  double external(int i) const { return stepForce[i] + gravityForce[i]; }
+  double external(int i) const { return stepForce[i] + gravityForce[i] + frameForce[i]; }
   // `energy`, when not null, receives the state forces' potential at q (the minimising solver needs
   // it: every state force it steps with must have one, up to a constant).
   const double* addStateForces(const double* q, double* force, double* energy = nullptr) const;

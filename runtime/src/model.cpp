@@ -61,6 +61,7 @@ size_t layOut(const ModelView& view, bool single, const qv_allocator& allocator,
   double* gravity = c.take<double>(3 * r);
   double* eigenvalues = c.take<double>(in.eigenvalueCount);
   double* rotations = view.rotations ? c.take<double>(3 * n * r) : nullptr;
+  double* rigidBody = view.rigidBody ? c.take<double>(qvr::rigidBodySize(r)) : nullptr;
   double* restStiffness = c.take<double>(r * r);
   // Used once, while loading: a few kilobytes, so that a model stays one allocation.
   double* scratch = c.take<double>(2 * r + ReducedPolynomial::scratchSize(in.r));
@@ -71,7 +72,7 @@ size_t layOut(const ModelView& view, bool single, const qv_allocator& allocator,
   m->info = qv_model_info{static_cast<int>(in.r), static_cast<int>(in.vertexCount), static_cast<int>(in.tetCount),
                           static_cast<int>(in.triangleCount), static_cast<int>(in.fileVertexCount),
                           static_cast<int>(in.eigenvalueCount), static_cast<int>(in.basisPrecision),
-                          static_cast<int>(in.materialIsUniform), view.rotations ? 1 : 0, in.youngsModulus, in.poissonRatio, in.density,
+                          static_cast<int>(in.materialIsUniform), view.rotations ? 1 : 0, view.rigidBody ? 1 : 0, in.youngsModulus, in.poissonRatio, in.density,
                           in.totalMass, in.rayleighAlpha, in.rayleighBeta, in.timeStep,
                           {in.bboxMin[0], in.bboxMin[1], in.bboxMin[2]}, {in.bboxMax[0], in.bboxMax[1], in.bboxMax[2]}};
   m->polynomial.build(in.r, view.energy, single, polynomial);
@@ -87,6 +88,7 @@ size_t layOut(const ModelView& view, bool single, const qv_allocator& allocator,
   m->gravity = copy(gravity, view.gravity, 3 * r);
   m->eigenvalues = copy(eigenvalues, view.eigenvalues, in.eigenvalueCount);
   m->rotations = view.rotations ? copy(rotations, view.rotations, 3 * n * r) : nullptr;
+  m->rigidBody = view.rigidBody ? copy(rigidBody, view.rigidBody, qvr::rigidBodySize(r)) : nullptr;
   const double lambdaMax = restStiffnessAndLargestEigenvalue(*m, restStiffness, scratch);
   m->restStiffness = restStiffness;
   m->stableStep = lambdaMax > 0 ? 2.0 / std::sqrt(lambdaMax) : INFINITY;

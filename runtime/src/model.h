@@ -18,6 +18,7 @@ struct qv_model {
   const double* gravity;
   const double* eigenvalues;
   const double* rotations;      // 3n x r row-major modal rotations, or null
+  const double* rigidBody;      // a free object's RIGID_BODY moments (rigid_frame.h), or null
   const double* restStiffness;  // K(0), r x r: linear modal dynamics and modal warping step with it
   double stableStep;            // 2 / omega_max of K(0): central differences' limit
 

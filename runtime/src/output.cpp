@@ -20,6 +20,18 @@ void vertexDisplacement(const qv_instance& s, int v, double u[3]) {
   warping::warpDisplacement(w, d, u);
 }
 
+// In flight, body positions (X + u) into the world: x + R (X + u - c).
+void intoWorld(const qv_instance& s, float* p, size_t count) {
+  if (!s.flying()) return;
+  const double* c = s.model->rigidBody;
+  for (size_t k = 0; k < count; ++k) {
+    const double body[3] = {p[3 * k] - c[0], p[3 * k + 1] - c[1], p[3 * k + 2] - c[2]};
+    double world[3];
+    s.frame.toWorld(body, world);
+    for (int a = 0; a < 3; ++a) p[3 * k + a] = static_cast<float>(world[a]);
+  }
+}
+
 } // namespace
 
 void displacements(const qv_model& m, const double* q, float* out) {
@@ -40,13 +52,14 @@ void positions(const qv_instance& s, float* out) {
     displacements(m, s.q, out);
     for (size_t i = 0; i < 3 * static_cast<size_t>(m.info.vertex_count); ++i)
       out[i] = static_cast<float>(m.rest[i] + out[i]);
-    return;
+  } else {
+    for (int v = 0; v < m.info.vertex_count; ++v) {
+      double u[3];
+      vertexDisplacement(s, v, u);
+      for (int c = 0; c < 3; ++c) out[3 * v + c] = static_cast<float>(m.rest[3 * v + c] + u[c]);
+    }
   }
-  for (int v = 0; v < m.info.vertex_count; ++v) {
-    double u[3];
-    vertexDisplacement(s, v, u);
-    for (int c = 0; c < 3; ++c) out[3 * v + c] = static_cast<float>(m.rest[3 * v + c] + u[c]);
-  }
+  intoWorld(s, out, static_cast<size_t>(m.info.vertex_count));
 }
 
 void positionsOf(const qv_instance& s, const int* vertices, int count, float* out) {
@@ -55,6 +68,7 @@ void positionsOf(const qv_instance& s, const int* vertices, int count, float* ou
     vertexDisplacement(s, vertices[k], u);
     for (int c = 0; c < 3; ++c) out[3 * k + c] = static_cast<float>(s.model->rest[3 * vertices[k] + c] + u[c]);
   }
+  intoWorld(s, out, static_cast<size_t>(count));
 }
 
 void surfaceNormals(const qv_model& m, const float* p, float* normals) {

@@ -28,6 +28,8 @@ struct Recorder : ScenarioTarget {
 
   void addVertexForce(int v, const double f[3]) override { steps.back().forces.emplace_back(v, Eigen::Vector3d(f)); }
   void setGravity(const double g[3]) override { gravity = Eigen::Vector3d(g); }
+  void startFlight(const SimOptions& o) override { flight = Eigen::Vector3d(o.velocity.data()); }
+  Eigen::Vector3d flight = Eigen::Vector3d::Constant(-1);  // the velocity it was started with
   void setSprings(const std::vector<int>&, const std::vector<double>& t, double k) override {
     steps.back().springs = true;
     steps.back().targets = t;
@@ -141,4 +143,20 @@ TEST(Scenario, AGroupThatSelectsNothingIsNamed) {
   EXPECT_EQ(quiver::test::errorOf<std::runtime_error>([] { selectGroup(box(), "x>5"); }),
             "--group 'x>5' selects no vertex");
   EXPECT_NE(quiver::test::errorOf<std::runtime_error>([] { selectGroup(box(), "q<1"); }).find("--group: "), std::string::npos);
+}
+
+TEST(Scenario, FlightStartsFromTheOptionsAndNeedsFree) {
+  SimOptions o;
+  o.steps = 1;
+  o.velocity = {1, 2, 3};
+  Recorder target;
+  try {
+    runScenario(target, box(), o);
+    ADD_FAILURE() << "--velocity without --free was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("need --free"), std::string::npos) << e.what();
+  }
+  o.step.freeFlight = true;
+  runScenario(target, box(), o);
+  EXPECT_EQ(target.flight, Eigen::Vector3d(1, 2, 3));
 }

@@ -26,10 +26,10 @@ ModelContents smallBeamModel(const SmallModelSpec& spec) {
   material.density = spec.density;
   const std::vector<Material> perTet(m.tetCount(), material);
 
-  // Free DOFs: every vertex off the clamped face x = 0.
+  // Free DOFs: every vertex off the clamped face x = 0 (all of them for a free object).
   std::vector<int> free;
   for (int v = 0; v < m.vertexCount(); ++v)
-    if (m.vertices[v].x() > 1e-9)
+    if (spec.free || m.vertices[v].x() > 1e-9)
       for (int c = 0; c < 3; ++c) free.push_back(3 * v + c);
   const int n = static_cast<int>(free.size());
   const StVKForceModel stvk(m, perTet);
@@ -51,20 +51,27 @@ ModelContents smallBeamModel(const SmallModelSpec& spec) {
   // The bake's recipe (precompute/stages/basis.h): modes scaled by lambda_1 / lambda_i, every
   // modal derivative K Psi_ij = -H(phi_i, phi_j) scaled by lambda_1^2 / (lambda_i lambda_j) (and
   // sqrt 2 for i != j), then mass-PCA: the r dominant directions in the M inner product.
-  const int k = spec.modes;
-  std::vector<double> eigenvalues(eig.eigenvalues().data(), eig.eigenvalues().data() + k);
+  // A free object's first six eigenpairs are its rigid motions: the modes start after them, and
+  // the derivatives are solved in their M-orthogonal complement (K is singular on the rigid motions).
+  const int k = spec.modes, first = spec.free ? 6 : 0;
+  const Eigen::MatrixXd phi = eig.eigenvectors().rightCols(n - first);
+  const Eigen::VectorXd lambda = eig.eigenvalues().tail(n - first);
+  std::vector<double> eigenvalues(lambda.data(), lambda.data() + k);
   const double l1 = eigenvalues[0];
   Eigen::MatrixXd scaled(n, k + k * (k + 1) / 2);
-  for (int i = 0; i < k; ++i) scaled.col(i) = eig.eigenvectors().col(i) * (l1 / eigenvalues[i]);
-  const Eigen::LLT<Eigen::MatrixXd> solver(Kf);
+  for (int i = 0; i < k; ++i) scaled.col(i) = phi.col(i) * (l1 / eigenvalues[i]);
+  const Eigen::LLT<Eigen::MatrixXd> clamped(Kf);
+  const auto solve = [&](const Eigen::VectorXd& h) {  // free: K x = h for x M-orthogonal to the rigid motions
+    return spec.free ? Eigen::VectorXd(phi * (phi.transpose() * h).cwiseQuotient(lambda)) : Eigen::VectorXd(clamped.solve(h));
+  };
   int column = k;
   for (int i = 0; i < k; ++i)
     for (int j = i; j < k; ++j) {
       Eigen::VectorXd h, hf(n);
-      stvk.forceHessianAtRest(full(eig.eigenvectors().col(i)), full(eig.eigenvectors().col(j)), h);
+      stvk.forceHessianAtRest(full(phi.col(i)), full(phi.col(j)), h);
       for (int d = 0; d < n; ++d) hf[d] = -h[free[d]];
       const double weight = (i == j ? 1.0 : std::sqrt(2.0)) * l1 * l1 / (eigenvalues[i] * eigenvalues[j]);
-      scaled.col(column++) = solver.solve(hf) * weight;
+      scaled.col(column++) = solve(hf) * weight;
     }
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> pca(scaled.transpose() * Mf * scaled);
   const int last = static_cast<int>(scaled.cols()) - 1;
@@ -81,6 +88,7 @@ ModelContents smallBeamModel(const SmallModelSpec& spec) {
   const Eigen::MatrixXd gravity = U.transpose() * M * axes;  // r x 3
   ExportSettings settings;
   settings.basisPrecision = spec.basisPrecision;
+  settings.rigidBody = spec.free;
   return makeModelContents(mesh, perTet, U, energyCoefficientsFromGram(gram.data(), gram.rows(), r), eigenvalues,
                            gravity, settings);
 }

@@ -1,7 +1,7 @@
 #pragma once
 // A small model made the way the bake makes one, from common/ and formats/ alone (dense Eigen
 // instead of PETSc/SLEPc/MPI): a cantilever beam clamped at x = 0, its lowest modes and their
-// modal derivatives, mass-PCA into U, and the exact reduced StVK energy of U. The runtime's and
+// modal derivatives (or, free, its lowest elastic modes and theirs), mass-PCA into U, and the exact reduced StVK energy of U. The runtime's and
 // the tools' tests load it, so they build and run without the bake.
 #include <array>
 #include <string>
@@ -20,6 +20,8 @@ struct SmallModelSpec {
   int modes = 6;         // k lowest modes and their k(k+1)/2 derivatives
   int rank = 10;         // r
   int basisPrecision = 64;
+  bool free = false;     // no clamped face: the six rigid motions are left out of the basis, and the
+                         // model carries its mass moments (RIGID_BODY) to fly
 };
 
 ModelContents smallBeamModel(const SmallModelSpec& spec = {});

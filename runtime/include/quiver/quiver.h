@@ -16,7 +16,7 @@ extern "C" {
 #endif
 
 #define QV_VERSION_MAJOR 0
-#define QV_VERSION_MINOR 2
+#define QV_VERSION_MINOR 3
 #define QV_VERSION_PATCH 0
 #define QV_VERSION_NUMBER (QV_VERSION_MAJOR * 10000 + QV_VERSION_MINOR * 100 + QV_VERSION_PATCH)
 
@@ -64,6 +64,7 @@ typedef struct qv_model_info {
   int basis_precision;       /* 32 or 64 bits per stored basis entry */
   int material_is_uniform;   /* 1: one material; 0: mixed (the values below are volume-weighted means) */
   int has_modal_rotations;   /* 1: the model can be simulated with modal warping */
+  int has_rigid_body;        /* 1: baked free (no fixed vertex), with its mass moments: instances can fly */
   double youngs_modulus;     /* Pa */
   double poisson_ratio;
   double density;            /* kg/m^3 */
@@ -181,6 +182,7 @@ typedef struct qv_instance_config {
   double max_displacement;   /* m; QV_SOLVER_NEWTON and central differences: a step that moves a vertex farther resets
                                 the instance; default 100 x the model's diagonal */
   qv_elasticity elasticity;  /* default QV_ELASTICITY_STVK */
+  int free_flight;           /* 1: the object flies in a moving frame (qv_rigid_state; needs has_rigid_body); default 0 */
 } qv_instance_config;
 
 /* Defaults for `model` (pass NULL for model-independent defaults). */
@@ -249,10 +251,27 @@ QV_API qv_result qv_instance_restore_snapshot(qv_instance* instance, const void*
 QV_API void qv_instance_reset(qv_instance* instance);
 QV_API void qv_instance_energies(const qv_instance* instance, double* kinetic, double* elastic);
 
+/* ---- Free flight ----
+   An instance with config.free_flight = 1 is a rigid frame, its centre of mass at `position` turned by
+   `orientation`, carrying the deformation q (docs/architecture.md, "Free flight"). Every position and normal it
+   hands out is in the world; vertex forces and gravity are world vectors and act on the frame and on q alike
+   (a uniform field such as gravity moves the frame only). Without external forces its linear and angular
+   momentum stay what they were to round-off. It starts where the model was baked, at rest; a reset returns it
+   to the last state set here, at rest. Penalty constraints (qv_instance_set_constraint) are for pinned models. */
+typedef struct qv_rigid_state {
+  double position[3];          /* m, world position of the centre of mass (at creation: the baked one) */
+  double orientation[4];       /* unit quaternion w, x, y, z turning the baked model into the world (normalised on set) */
+  double linear_velocity[3];   /* m/s, of the centre of mass */
+  double angular_velocity[3];  /* rad/s, world axes */
+} qv_rigid_state;
+/* QV_ERROR_INVALID_ARGUMENT for an instance that does not fly or non-finite values. */
+QV_API qv_result qv_instance_get_rigid_state(const qv_instance* instance, qv_rigid_state* state);
+QV_API qv_result qv_instance_set_rigid_state(qv_instance* instance, const qv_rigid_state* state);
+
 /* Largest stable time step of central differences at rest (2 / omega_max), s. */
 QV_API double qv_instance_stable_time_step(const qv_instance* instance);
 
-/* Output into caller-owned buffers: deformed positions X + U q (3 floats per vertex), of all
+/* Output into caller-owned buffers: deformed positions X + U q (3 floats per vertex; x + R (X - c + U q) in flight), of all
    vertices or of the listed ones; and area-weighted vertex normals of the surface, computed
    from `positions` of all vertices (3 floats per vertex; vertices off the surface get 0). */
 QV_API void qv_instance_positions(const qv_instance* instance, float* positions);

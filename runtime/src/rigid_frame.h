@@ -1,0 +1,81 @@
+#pragma once
+// Free flight: a free object's moving frame (the floating frame of reference of reduced
+// deformables). The state is the frame, its centre of mass x, orientation R, velocity v and
+// angular momentum L in the world, and the deformation q, q' in the frame; a vertex is at
+//   x + R p,  p = X - c + U q  (body frame; c the rest centre of mass).
+// A free bake's basis is M-orthogonal to the rigid motions, so the centre of mass stays at the
+// frame's origin and U q carries no momentum of its own to first order.
+//
+// What each step keeps, and how (docs/architecture.md, "Free flight"):
+// - Linear and angular momentum are the state: P = m v and L change only by the external force
+//   and torque (symplectic Euler), so without them both are conserved to round-off whatever the
+//   deformation does. x then moves with the new v.
+// - The angular velocity follows from L: omega = R I(q)^-1 (R^T L - h), with the deformed
+//   inertia I(q) and the deformation's own angular momentum h = \int rho p x p' (the model's
+//   RIGID_BODY moments give both exactly). R turns by exp(h omega), omega at the midpoint turn.
+// - The deformation feels the frame's inertial forces -U^T M (omega x (omega x p) + omega' x p
+//   + 2 omega x p'), with omega = I(q)^-1 L_b and L_b = R^T L - h held over the step:
+//   - centrifugal, as the potential V(q) = L_b . I(q)^-1 L_b / 2 (the rotational energy at that
+//     angular momentum), whose gradient is exactly the centrifugal force. It is a state force
+//     (loads.h): implicit, in the minimising step's energy, so that spinning and vibrating trade
+//     energy without making any;
+//   - Euler, omega' x p, with omega' by difference over the last step: explicit, a per-step force;
+//   - Coriolis, 2 omega x p', is left out: it is gyroscopic (no work), second order in the
+//     deformation for a basis M-orthogonal to the rigid motions, and taken explicitly it pumps
+//     energy into the vibration (measured: a tumbling bar's energy grew 7x in 5 s).
+//   External forces act on all three: F and x_v x f on the frame, U_v^T R^T f on q.
+#include "model.h"
+
+namespace quiver::rt {
+
+struct RigidFrame {
+  double position[3] = {};         // x, m, the centre of mass in the world
+  double orientation[4] = {1, 0, 0, 0};  // unit quaternion w, x, y, z: body to world
+  double velocity[3] = {};         // v, m/s
+  double angularMomentum[3] = {};  // L, kg m^2/s, about x, in the world
+  double rotation[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  // R from `orientation`, row-major
+  double bodyOmega[3] = {};        // omega in the body frame at the current state
+  double inertia[9] = {};          // I(q), body frame, at the current state
+  double internal[3] = {};         // h = \int rho p x p', body frame, at the current state
+  double lastBodyOmega[3] = {};    // at the start of the last step: omega' by difference
+  double force[3] = {}, torque[3] = {};  // this step's, world; torque about x
+  double gravity[3] = {};          // persistent acceleration, m/s^2, world
+  double homePosition[3] = {};     // where a reset puts the frame (the last set state), at rest
+  double homeOrientation[4] = {1, 0, 0, 0};
+  double* moments = nullptr;       // 9 x r: y_ab = \int rho p_a U_b at the current state
+  double* products = nullptr;      // 9 x r: A_ab q at the centrifugal potential's trial q
+  double heldMomentum[3] = {};     // L_b = R^T L - h, body frame, held over a step (holdSpin())
+
+  static size_t scratchDoubles(int r) { return 18 * static_cast<size_t>(r); }
+  // Takes its scratch from `scratch` (scratchDoubles(r) doubles).
+  void attach(double* scratch, int r);
+  void setOrientation(const double quaternion[4]);  // normalises, updates `rotation`
+  // Brings moments, rates and bodyOmega up to date with the frame and (q, q').
+  void refresh(const qv_model& model, const double* q, const double* qdot);
+  // The world angular velocity R bodyOmega.
+  void worldOmega(double omega[3]) const;
+  // Sets L so that the world angular velocity is `omega` at (q, q') (refresh() first).
+  void setWorldOmega(const double omega[3]);
+  // Holds L_b = R^T L - h for this step's centrifugal potential (refresh() first).
+  void holdSpin();
+  // The centrifugal potential V(q) = L_b . I(q)^-1 L_b / 2: adds its gradient to `resisting` (the
+  // resisting sign of loads.h) and its Gauss-Newton Hessian (omega held) to `jacobian`; returns V.
+  double addCentrifugal(const qv_model& model, const double* q, double* resisting, double* jacobian) const;
+  // Adds the Euler force -U^T M (omega' x p) on q (refresh() first), with omega' over `h`.
+  void addInertialForces(const qv_model& model, double h, double* reducedForce) const;
+  // The frame's share of the step: momenta by this step's force, torque and gravity, then x and R.
+  void advance(const qv_model& model, double h);
+  // Orientation `from` turned by t |omega| about the world axis omega.
+  void turn(const double from[4], const double omega[3], double t);
+  // World position of body point p: x + R p.
+  void toWorld(const double p[3], double out[3]) const;
+  // Body direction of world vector f: R^T f.
+  void toBody(const double f[3], double out[3]) const;
+  // Kinetic energy of the frame's motion and its coupling to q': m |v|^2 / 2 + omega . (I omega / 2
+  // + h) (refresh() first); with |q'|^2 / 2 the body's whole kinetic energy.
+  double kineticEnergy(const qv_model& model) const;
+  void goHome();  // the home pose, at rest
+  bool finite() const;
+};
+
+} // namespace quiver::rt

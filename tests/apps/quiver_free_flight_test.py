@@ -1,0 +1,73 @@
+#!/usr/bin/python3
+"""Free flight from the tools, as a user meets it: a beam baked with no fixed vertex carries its rigid
+body (quiver info: centre of mass and inertia, against the box's by hand), `quiver sim --free` throws
+and drops it (its centre against x0 + v t - g t^2 / 2, with symplectic Euler's g h t / 2), and the
+options that need --free or a free bake say so."""
+import json
+import os
+import subprocess
+import tempfile
+import unittest
+
+import numpy as np
+
+BAKE = os.environ["QUIVER_BAKE"]
+MESH = os.environ["QUIVER_MESH"]
+QUIVER = os.environ["QUIVER"]
+MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
+
+
+def run(*args, codes=(0,)):
+    p = subprocess.run([*map(str, args)], capture_output=True, text=True, stdin=subprocess.DEVNULL, timeout=600)
+    assert p.returncode in codes, p.stderr
+    return p
+
+
+class FreeFlight(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        d = cls.tmp.name
+        mesh = os.path.join(d, "beam.vtu")
+        run(MESH, "beam", "--size", "0.6,0.1,0.1", "--cells", "12,2,2", "-o", mesh)
+        material = ["--E", "1e6", "--nu", "0.4", "--density", "1000", "--modes", 8, "--rank", 16, "--quiet"]
+        cls.free = os.path.join(d, "free")
+        run(MPIEXEC, "-n", "2", "--oversubscribe", BAKE, mesh, *material, "-o", cls.free)
+        cls.pinned = os.path.join(d, "pinned")
+        run(BAKE, mesh, "--fix", "x<min+1e-9", *material, "--no-fidelity", "-o", cls.pinned)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_info_reports_the_rigid_body(self):
+        info = json.loads(run(QUIVER, "info", self.free + ".qvr").stdout)
+        m, (a, b, c) = 0.6 * 0.1 * 0.1 * 1000, (0.6, 0.1, 0.1)
+        self.assertAlmostEqual(info["total_mass"], m, places=9)
+        np.testing.assert_allclose(info["rigid_body"]["centre_of_mass"], [0.3, 0.05, 0.05], atol=1e-12)
+        inertia = np.diag([m * (b * b + c * c), m * (a * a + c * c), m * (a * a + b * b)]) / 12
+        np.testing.assert_allclose(info["rigid_body"]["inertia"], inertia, atol=1e-12)
+        self.assertIsNone(json.loads(run(QUIVER, "info", self.pinned + ".qvr").stdout)["rigid_body"])
+
+    def test_thrown_and_dropped(self):
+        h, steps = 1 / 60, 90
+        p = run(QUIVER, "sim", self.free + ".qvr", "--free", "--gravity", "--position", "0,0,2", "--velocity", "1,0.5,3",
+                "--angular-velocity", "0,2,5", "--steps", steps, "--hold", 0, "--dt", h, "--json")
+        j = json.loads(p.stdout)
+        t, g = steps * h, 9.81
+        expected = [0.3 + 1 * t, 0.05 + 0.5 * t, 0.05 + 2 + 3 * t - g * t * t / 2 - g * h * t / 2]
+        np.testing.assert_allclose(j["final_center"], expected, atol=1e-9)
+        self.assertAlmostEqual(j["final_speed_mps"], np.linalg.norm([1, 0.5, 3 - g * t]), places=9)
+        self.assertEqual(j["resets"], 0)
+
+    def test_what_needs_free_says_so(self):
+        p = run(QUIVER, "sim", self.free + ".qvr", "--velocity", "1,0,0", "--steps", 2, codes=(1,))
+        self.assertIn("need --free", p.stderr)
+        p = run(QUIVER, "sim", self.pinned + ".qvr", "--free", "--steps", 2, codes=(1,))
+        self.assertIn("pinned.qvr was baked with fixed vertices", p.stderr)
+        p = run(QUIVER, "sim", self.free + ".qvr", "--free", "--angular-velocity", "nan,0,0", "--steps", 2, codes=(1,))
+        self.assertIn("must be finite", p.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

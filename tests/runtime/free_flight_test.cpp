@@ -1,0 +1,275 @@
+// Free flight (rigid_frame.h) against physics the runtime does not compute: momentum measured from
+// the world positions it hands out (central differences, the consistent mass of the mesh), free fall
+// against x0 - g t^2 / 2, the momentum a push adds against F h and (x_v - x) x F h, and a spinning
+// bar's stretch against the analytic rho omega^2 L^3 / (12 E).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+
+#include "common/mass_matrix.h"
+#include "formats/model/qvr_writer.h"
+#include "quiver/quiver.h"
+#include "runtime_fixture.h"
+#include "tests/support/small_model.h"
+
+namespace quiver {
+namespace {
+
+constexpr double kRho = 1000, kE = 1e6;
+
+// A free 0.6 x 0.1 x 0.1 bar, loaded from memory, with the mesh and consistent mass to measure it by.
+struct FreeBar {
+  qv_model* model = nullptr;
+  qv_model_info info{};
+  Eigen::SparseMatrix<double> mass;  // n x n, the consistent mass's x-x block
+
+  explicit FreeBar(int rank = 10) {
+    test::SmallModelSpec spec;
+    spec.cells = {6, 1, 1};
+    spec.free = true;
+    spec.rank = rank;
+    spec.youngsModulus = kE;
+    spec.density = kRho;
+    const ModelContents contents = test::smallBeamModel(spec);
+    const std::string bytes = formatModel(contents);
+    char message[512] = "";
+    EXPECT_EQ(qv_model_load_memory(bytes.data(), bytes.size(), nullptr, nullptr, &model, message, sizeof message), QV_OK)
+        << message;
+    qv_model_get_info(model, &info);
+    TetMesh mesh;
+    for (size_t v = 0; v < contents.restPositions.size() / 3; ++v)
+      mesh.vertices.emplace_back(contents.restPositions[3 * v], contents.restPositions[3 * v + 1], contents.restPositions[3 * v + 2]);
+    for (size_t t = 0; t < contents.tets.size() / 4; ++t)
+      mesh.tets.push_back({int(contents.tets[4 * t]), int(contents.tets[4 * t + 1]), int(contents.tets[4 * t + 2]),
+                           int(contents.tets[4 * t + 3])});
+    Material m;
+    m.density = kRho;
+    const Eigen::SparseMatrix<double> full = consistentMassMatrix(mesh, std::vector<Material>(mesh.tets.size(), m));
+    std::vector<Eigen::Triplet<double>> entries;
+    for (int col = 0; col < full.outerSize(); ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(full, col); it; ++it)
+        if (it.row() % 3 == 0 && it.col() % 3 == 0) entries.emplace_back(it.row() / 3, it.col() / 3, it.value());
+    mass.resize(mesh.vertexCount(), mesh.vertexCount());
+    mass.setFromTriplets(entries.begin(), entries.end());
+  }
+  ~FreeBar() { qv_model_destroy(model); }
+
+  qv_instance_config config(double h) const {
+    qv_instance_config c;
+    qv_instance_config_init(&c, model);
+    c.free_flight = 1;
+    c.time_step = h;
+    c.rayleigh_alpha = c.rayleigh_beta = 0;
+    return c;
+  }
+  Eigen::MatrixXd positions(const qv_instance* s) const {
+    std::vector<float> p(3 * static_cast<size_t>(info.vertex_count));
+    qv_instance_positions(s, p.data());
+    Eigen::MatrixXd out(info.vertex_count, 3);
+    for (int v = 0; v < info.vertex_count; ++v)
+      for (int c = 0; c < 3; ++c) out(v, c) = p[3 * v + c];
+    return out;
+  }
+  Eigen::Vector3d centre(const Eigen::MatrixXd& x) const {  // exact for the linear field x
+    const Eigen::VectorXd w = mass * Eigen::VectorXd::Ones(info.vertex_count);
+    return x.transpose() * w / w.sum();
+  }
+  // Linear and angular momentum (about the origin) of positions x moving with velocities xd:
+  // \int rho x' and \int rho x x x', as the consistent mass integrates them.
+  void momentum(const Eigen::MatrixXd& x, const Eigen::MatrixXd& xd, Eigen::Vector3d& P, Eigen::Vector3d& L) const {
+    const Eigen::MatrixXd Mxd = mass * xd;
+    P = Mxd.colwise().sum().transpose();
+    L.setZero();
+    for (int v = 0; v < info.vertex_count; ++v) L += Eigen::Vector3d(x.row(v)).cross(Eigen::Vector3d(Mxd.row(v)));
+  }
+};
+
+TEST(FreeFlight, ModelsAndInstancesSayWhetherTheyFly) {
+  FreeBar bar;
+  ASSERT_NE(bar.model, nullptr);
+  EXPECT_EQ(bar.info.has_rigid_body, 1);
+  test::TestModel pinned;
+  ASSERT_NE(pinned.model, nullptr);
+  EXPECT_EQ(pinned.info.has_rigid_body, 0);
+  qv_instance_config c = bar.config(1.0 / 60);
+  qv_instance* s = nullptr;
+  EXPECT_EQ(qv_instance_create(pinned.model, &c, nullptr, &s), QV_ERROR_INVALID_ARGUMENT);  // nothing to fly with
+  test::Instance flying(bar.model, c);
+  qv_rigid_state state;
+  ASSERT_EQ(qv_instance_get_rigid_state(flying.s, &state), QV_OK);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(state.position[a], a == 0 ? 0.3 : 0.05, 1e-12);  // the baked centre
+  EXPECT_EQ(state.orientation[0], 1.0);
+  const int vertices[1] = {0};
+  const double target[3] = {0, 0, 0};
+  EXPECT_EQ(qv_instance_set_constraint(flying.s, 0, vertices, 1, target, 100.0), QV_ERROR_INVALID_ARGUMENT);
+  state.angular_velocity[1] = NAN;
+  EXPECT_EQ(qv_instance_set_rigid_state(flying.s, &state), QV_ERROR_INVALID_ARGUMENT);
+  c.free_flight = 0;
+  test::Instance grounded(bar.model, c);
+  EXPECT_EQ(qv_instance_get_rigid_state(grounded.s, &state), QV_ERROR_INVALID_ARGUMENT);
+  // At rest where it was baked: the world positions are the rest positions.
+  const Eigen::MatrixXd x = bar.positions(flying.s);
+  const double* rest = qv_model_rest_positions(bar.model);
+  for (int v = 0; v < bar.info.vertex_count; ++v)
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(x(v, a), rest[3 * v + a], 1e-6);
+}
+
+// 10 s of a tumbling bar (spun about no principal axis) that also vibrates: the momentum its world
+// positions carry stays what it was.
+TEST(FreeFlight, SpinningVibratingBarKeepsItsMomentum) {
+  FreeBar bar;
+  ASSERT_NE(bar.model, nullptr);
+  const double h = 1.0 / 240;
+  test::Instance inst(bar.model, bar.config(h));
+  std::vector<double> qd(bar.info.r, 0.0);
+  qd[0] = 2.0;  // a vibration: the first basis vector at 2 /s (M-orthonormal: 2 sqrt(kg) m/s)
+  qd[3] = -1.0;
+  qv_instance_set_state(inst.s, nullptr, qd.data(), nullptr);
+  const qv_rigid_state start = {{1, 2, 3}, {0.9, 0.1, -0.3, 0.2}, {0.5, -0.2, 0.1}, {1.0, 4.0, 0.5}};
+  ASSERT_EQ(qv_instance_set_rigid_state(inst.s, &start), QV_OK);
+  const auto energy = [&] {
+    double kinetic = 0, elastic = 0;
+    qv_instance_energies(inst.s, &kinetic, &elastic);
+    return kinetic + elastic;
+  };
+  const double initialEnergy = energy();
+  double highestEnergy = initialEnergy;
+  Eigen::MatrixXd before = bar.positions(inst.s);
+  ASSERT_EQ(qv_instance_step(inst.s), QV_STEP_OK);
+  Eigen::MatrixXd now = bar.positions(inst.s);
+  Eigen::Vector3d P0 = Eigen::Vector3d::Zero(), L0 = Eigen::Vector3d::Zero();
+  double worstP = 0, worstL = 0, largestQ = 0;
+  for (int step = 1; step <= 2400; ++step) {
+    ASSERT_NE(qv_instance_step(inst.s), QV_STEP_RESET);
+    const Eigen::MatrixXd after = bar.positions(inst.s);
+    if (step % 10 == 1) {
+      Eigen::Vector3d P, L;
+      bar.momentum(now, (after - before) / (2 * h), P, L);
+      if (step == 1) P0 = P, L0 = L;
+      worstP = std::max(worstP, (P - P0).norm() / P0.norm());
+      worstL = std::max(worstL, (L - L0).norm() / L0.norm());
+      std::vector<double> q(bar.info.r);
+      qv_instance_get_state(inst.s, q.data(), nullptr, nullptr);
+      largestQ = std::max(largestQ, Eigen::Map<Eigen::VectorXd>(q.data(), bar.info.r).norm());
+      highestEnergy = std::max(highestEnergy, energy());
+    }
+    before = now;
+    now = after;
+  }
+  // The expected momentum, from the state as set: m v, and the frame's L plus x m v.
+  EXPECT_LT((P0 - bar.info.total_mass * Eigen::Vector3d(0.5, -0.2, 0.1)).norm(), 1e-4 * P0.norm());
+  std::printf("10 s tumbling and vibrating: momentum within %.2e (linear) and %.2e (angular), |q| up to %.3g, "
+              "energy %.4g J at the start, at most %+.2e relative above it, %+.2e at the end\n", worstP, worstL, largestQ,
+              initialEnergy, highestEnergy / initialEnergy - 1, energy() / initialEnergy - 1);
+  EXPECT_GT(largestQ, 0.005);  // it does vibrate (2 / omega of the vectors set moving)
+  EXPECT_LT(worstP, 1e-4);  // float positions
+  EXPECT_LT(worstL, 1e-3);  // central differences of float positions at h = 1/240 s
+  // No damping: the energy neither grows (the spin's centrifugal potential is in the step) nor
+  // leaks much (the explicit Euler force and the left-out Coriolis force).
+  EXPECT_LT(highestEnergy, initialEnergy * (1 + 1e-3));
+  EXPECT_GT(energy(), 0.9 * initialEnergy);
+}
+
+TEST(FreeFlight, FreeFallIsHalfGTSquaredAndDeformsNothing) {
+  FreeBar bar;
+  ASSERT_NE(bar.model, nullptr);
+  const double h = 1.0 / 60;
+  test::Instance inst(bar.model, bar.config(h));
+  const double g[3] = {0, 0, -QV_STANDARD_GRAVITY};
+  qv_instance_set_gravity(inst.s, g);
+  const Eigen::Vector3d start = bar.centre(bar.positions(inst.s));
+  for (int n = 1; n <= 120; ++n) {
+    ASSERT_EQ(qv_instance_step(inst.s), QV_STEP_OK);
+    const double t = n * h;
+    const Eigen::Vector3d c = bar.centre(bar.positions(inst.s));
+    // Symplectic Euler lands g h t / 2 below the parabola: first order in h, exact otherwise.
+    EXPECT_NEAR(c.z(), start.z() - 0.5 * QV_STANDARD_GRAVITY * t * t - 0.5 * QV_STANDARD_GRAVITY * h * t, 1e-5);
+    EXPECT_NEAR(c.x(), start.x(), 1e-6);
+  }
+  std::vector<double> q(bar.info.r);
+  qv_instance_get_state(inst.s, q.data(), nullptr, nullptr);
+  EXPECT_LT(Eigen::Map<Eigen::VectorXd>(q.data(), bar.info.r).norm(), 1e-9);  // a uniform field stretches nothing
+}
+
+TEST(FreeFlight, APushAddsItsImpulseAndItsAngularImpulse) {
+  FreeBar bar;
+  ASSERT_NE(bar.model, nullptr);
+  const double h = 1.0 / 120;
+  test::Instance inst(bar.model, bar.config(h));
+  const Eigen::MatrixXd x = bar.positions(inst.s);
+  const Eigen::Vector3d c = bar.centre(x);
+  int tip = 0;
+  for (int v = 0; v < bar.info.vertex_count; ++v)
+    if (x(v, 0) > x(tip, 0)) tip = v;
+  const double F[3] = {0, 30, 10};
+  ASSERT_EQ(qv_instance_add_vertex_force(inst.s, tip, F), QV_OK);
+  ASSERT_EQ(qv_instance_step(inst.s), QV_STEP_OK);
+  qv_rigid_state state;
+  ASSERT_EQ(qv_instance_get_rigid_state(inst.s, &state), QV_OK);
+  const Eigen::Vector3d f(F[0], F[1], F[2]);
+  const Eigen::Vector3d v(state.linear_velocity[0], state.linear_velocity[1], state.linear_velocity[2]);
+  EXPECT_LT((bar.info.total_mass * v - f * h).norm(), 1e-12 * f.norm() * h);
+  // The angular momentum it was given, measured from the positions of the next steps.
+  const Eigen::MatrixXd x1 = bar.positions(inst.s);
+  ASSERT_EQ(qv_instance_step(inst.s), QV_STEP_OK);
+  const Eigen::MatrixXd x2 = bar.positions(inst.s);
+  Eigen::Vector3d P, L;
+  const Eigen::MatrixXd mid = 0.5 * (x1 + x2);
+  bar.momentum(mid.rowwise() - bar.centre(mid).transpose(), (x2 - x1) / h, P, L);
+  const Eigen::Vector3d expected = (Eigen::Vector3d(x.row(tip)) - c).cross(f) * h;
+  EXPECT_LT((L - expected).norm(), 0.02 * expected.norm()) << L.transpose() << " vs " << expected.transpose();
+}
+
+TEST(FreeFlight, SnapshotsRewindFlightBitForBit) {
+  FreeBar bar;
+  ASSERT_NE(bar.model, nullptr);
+  test::Instance inst(bar.model, bar.config(1.0 / 60));
+  const qv_rigid_state start = {{0, 0, 1}, {1, 0, 0, 0}, {1, 0, 0}, {0, 3, 1}};
+  ASSERT_EQ(qv_instance_set_rigid_state(inst.s, &start), QV_OK);
+  for (int i = 0; i < 5; ++i) qv_instance_step(inst.s);
+  std::vector<double> snapshot(qv_instance_snapshot_size(inst.s) / sizeof(double));
+  qv_instance_save_snapshot(inst.s, snapshot.data());
+  for (int i = 0; i < 20; ++i) qv_instance_step(inst.s);
+  const Eigen::MatrixXd first = bar.positions(inst.s);
+  ASSERT_EQ(qv_instance_restore_snapshot(inst.s, snapshot.data(), snapshot.size() * sizeof(double)), QV_OK);
+  for (int i = 0; i < 20; ++i) qv_instance_step(inst.s);
+  EXPECT_EQ(bar.positions(inst.s), first);
+}
+
+// The centrifugal force of the moving frame, seen: a bar spinning about a transverse axis, damped to
+// steady spin, stretches by rho omega^2 L^3 / (12 E) (1D bar, the basis's share of it).
+TEST(FreeFlight, ASpinningBarStretchesAsTheCentrifugalForceSays) {
+  FreeBar bar(20);
+  ASSERT_NE(bar.model, nullptr);
+  qv_instance_config c = bar.config(1.0 / 240);
+  c.rayleigh_alpha = 20;  // damps the deformation, not the spin
+  test::Instance inst(bar.model, c);
+  const double omega = 15;  // rad/s; the first elastic mode is near 57
+  const qv_rigid_state start = {{0, 0, 0}, {1, 0, 0, 0}, {0, 0, 0}, {0, 0, omega}};
+  ASSERT_EQ(qv_instance_set_rigid_state(inst.s, &start), QV_OK);
+  for (int i = 0; i < 960; ++i) ASSERT_EQ(qv_instance_step(inst.s), QV_STEP_OK);
+  // Length along the bar's own axis: the spread of the end faces' centres.
+  std::vector<double> q(bar.info.r);
+  qv_instance_get_state(inst.s, q.data(), nullptr, nullptr);
+  std::vector<float> u(3 * static_cast<size_t>(bar.info.vertex_count));
+  qv_model_displacements(bar.model, q.data(), u.data());
+  const double* rest = qv_model_rest_positions(bar.model);
+  double left = 0, right = 0;
+  int nl = 0, nr = 0;
+  for (int v = 0; v < bar.info.vertex_count; ++v) {
+    if (rest[3 * v] < 1e-9) left += u[3 * v], ++nl;
+    if (rest[3 * v] > 0.6 - 1e-9) right += u[3 * v], ++nr;
+  }
+  const double stretch = right / nr - left / nl, expected = kRho * omega * omega * 0.216 / (12 * kE);
+  std::printf("bar spinning at %.0f rad/s: stretched %.3g m, 1D theory %.3g m\n", omega, stretch, expected);
+  EXPECT_GT(stretch, 0.5 * expected);
+  EXPECT_LT(stretch, 1.5 * expected);
+}
+
+} // namespace
+} // namespace quiver
