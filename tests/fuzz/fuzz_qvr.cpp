@@ -4,7 +4,7 @@
 // the checks behind the checksums. A refusal must say why. An accepted model is copied element by
 // element through the view's pointers (ASan checks every one), must pass the writer's validation,
 // and must parse back to a model that formats to the same bytes; then the runtime loads it, and
-// evaluates and steps it once (so its load-time expansion and first step meet hostile numbers
+// evaluates and steps it once, flying too where it can (so its load-time expansion and first step meet hostile numbers
 // too); anything else aborts.
 #include <cstddef>
 #include <cstdint>
@@ -43,6 +43,15 @@ void runtimeSmoke(const void* data, size_t size) {
   if (qv_instance_create(model, &config, nullptr, &instance) == QV_OK) {
     qv_instance_set_state(instance, q.data(), nullptr, nullptr);
     qv_instance_step(instance);
+    qv_instance_destroy(instance);
+  }
+  config.free_flight = info.has_rigid_body;  // a free model also flies: pushed off-centre, stepped, drawn
+  if (config.free_flight && qv_instance_create(model, &config, nullptr, &instance) == QV_OK) {
+    const double push[3] = {1, 2, 3};
+    qv_instance_add_vertex_force(instance, 0, push);
+    qv_instance_step(instance);
+    std::vector<float> positions(3 * static_cast<size_t>(info.vertex_count));
+    qv_instance_positions(instance, positions.data());
     qv_instance_destroy(instance);
   }
   qv_model_destroy(model);

@@ -107,6 +107,12 @@ def write_qvr_seeds():
     sections[0] = (1, 0, sections[0][2] + struct.pack("<2d", 1.5, -2.5))
     sections.insert(4, (200, 1, b"data of a later version"))
     open(write("qvr", "newer_minor.qvr"), "wb").write(qvr_file(sections[::-1], 1, bytes(range(64))))
+    # A free model: RIGID_BODY (type 12, optional) with centre c, second moments S0, B (9 x r), A (9 x r x r).
+    r = 2
+    rigid = [0.525, 0.025, -0.225] + [2e-4, 1e-5, 0, 1e-5, 3e-4, 0, 0, 0, 4e-4]
+    rigid += [0.01 * math.cos(i) for i in range(9 * r)] + [0.05 * math.sin(i) for i in range(9 * r * r)]
+    free = qvr_sections(64, True) + [(12, 1, struct.pack(f"<{len(rigid)}d", *rigid))]
+    open(write("qvr", "free_rigid_body.qvr"), "wb").write(qvr_file(free))
 
 
 def main():
