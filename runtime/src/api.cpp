@@ -1,6 +1,7 @@
 // The C API: argument checks, then one call into the runtime's parts (model, instance, loads,
 // integrators, elasticity, output). Nothing here computes.
 #include <cerrno>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -8,6 +9,7 @@
 #include <cstring>
 #include <string>
 
+#include "contact.h"
 #include "elasticity.h"
 #include "instance.h"
 #include "integrators/integrator.h"
@@ -346,6 +348,32 @@ qv_result qv_instance_set_rigid_state(qv_instance* s, const qv_rigid_state* stat
   f.refresh(*s->model, s->q, s->v);
   f.setWorldOmega(state->angular_velocity);
   return QV_OK;
+}
+
+qv_result qv_instance_set_colliders(qv_instance* s, const qv_collider* colliders, int count) {
+  if (!s || !s->flying() || count < 0 || (count > 0 && !colliders)) return QV_ERROR_INVALID_ARGUMENT;
+  for (int k = 0; k < count; ++k)
+    if (!quiver::rt::validCollider(colliders[k])) return QV_ERROR_INVALID_ARGUMENT;
+  s->colliders = count ? colliders : nullptr;
+  s->colliderCount = count;
+  return QV_OK;
+}
+
+int qv_instance_contacts(const qv_instance* s, qv_contact* out, int capacity) {
+  if (!s) return 0;
+  for (int j = 0; out && j < std::min(capacity, s->contactCount); ++j) {
+    const quiver::rt::Contact& c = s->contacts[j];
+    qv_contact& o = out[j];
+    o.vertex = c.vertex;
+    o.collider = c.collider;
+    o.depth = c.depth;
+    for (int a = 0; a < 3; ++a) {
+      o.point[a] = c.point[a];
+      o.normal[a] = c.normal[a];
+      o.impulse[a] = c.normalImpulse * c.normal[a] + c.tangentImpulse[0] * c.tangent[0][a] + c.tangentImpulse[1] * c.tangent[1][a];
+    }
+  }
+  return s->contactCount;
 }
 
 double qv_instance_stable_time_step(const qv_instance* s) { return s ? s->model->stableStep : 0; }

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <new>
 
+#include "contact.h"
 #include "dynamics.h"
 #include "elasticity.h"
 #include "integrators/integrator.h"
@@ -18,7 +19,8 @@ bool validConfig(const qv_model* model, const qv_instance_config* c) {
          c->elasticity < QV_ELASTICITY_COUNT && (!kElasticities[c->elasticity].needsRotations || model->rotations) &&
          c->time_step > 0 && std::isfinite(c->time_step) && c->newton_iterations >= 1 && c->rayleigh_alpha >= 0 &&
          c->rayleigh_beta >= 0 && c->max_constraints >= 0 && c->max_constraints <= 64 && c->max_displacement > 0 &&
-         (c->free_flight == 0 || (c->free_flight == 1 && model->rigidBody));
+         (c->free_flight == 0 || (c->free_flight == 1 && model->rigidBody)) && c->max_contacts >= 0 &&
+         c->max_contacts <= 4096;
 }
 
 void defaultConfig(qv_instance_config& config, const qv_model* model) {
@@ -39,12 +41,14 @@ void defaultConfig(qv_instance_config& config, const qv_model* model) {
   config.max_displacement = 100.0 * diagonal;
   config.elasticity = QV_ELASTICITY_STVK;
   config.free_flight = 0;
+  config.max_contacts = 64;
 }
 
 size_t instanceBytes(const qv_model& model, const qv_instance_config& config) {
   BlockCarver c(nullptr);
   c.take<qv_instance>(1);
   qv_instance probe{};
+  probe.model = &model;
   probe.r = model.info.r;
   probe.config = config;
   probe.carve(c);
@@ -71,6 +75,14 @@ qv_instance* constructInstance(const qv_model& model, const qv_instance_config& 
     std::memcpy(s->frame.homePosition, model.rigidBody, sizeof s->frame.homePosition);  // as baked
     s->loads.frame = &s->frame;
     s->loads.model = &model;
+    // The surface's vertices touch the world; a stored triangle marks its corners.
+    for (int v = 0; v < model.info.vertex_count; ++v) s->surfaceVertices[v] = 0;
+    for (size_t k = 0; k < 3 * static_cast<size_t>(model.info.triangle_count); ++k) s->surfaceVertices[model.triangles[k]] = 1;
+    for (int v = 0; v < model.info.vertex_count; ++v)
+      if (s->surfaceVertices[v]) s->surfaceVertices[s->surfaceCount++] = v;
+    double d2 = 0;
+    for (int a = 0; a < 3; ++a) d2 += std::pow(model.info.bbox_max[a] - model.info.bbox_min[a], 2);
+    s->contactSlop = 1e-3 * std::sqrt(d2);
   }
   s->rest();
   return s;
@@ -101,7 +113,11 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
   work.stateForceSink = c.take<double>(r);
   work.pivot = c.take<int>(r);
   work.polynomialScratch = c.take<double>(quiver::rt::ReducedPolynomial::scratchSize(r));
-  if (flying()) frame.attach(c.take<double>(quiver::rt::RigidFrame::scratchDoubles(r)), r);
+  if (flying()) {
+    frame.attach(c.take<double>(quiver::rt::RigidFrame::scratchDoubles(r)), r);
+    contacts = c.take<quiver::rt::Contact>(static_cast<size_t>(config.max_contacts));
+    surfaceVertices = c.take<int>(static_cast<size_t>(model->info.vertex_count));
+  }
 }
 
 void qv_instance::rest() {
@@ -110,6 +126,7 @@ void qv_instance::rest() {
   std::memset(a, 0, sizeof(double) * r);
   elasticEnergyAtState = 0;
   energySlack = 0;
+  contactCount = 0;
   if (flying()) frame.goHome();
 }
 
@@ -166,7 +183,9 @@ void qv_instance::beginFlight() {
   frame.toBody(accel, body);
   for (int j = 0; j < r; ++j)
     loads.frameForce[j] += model->gravity[j] * body[0] + model->gravity[r + j] * body[1] + model->gravity[2 * r + j] * body[2];
-  frame.advance(*model, h);
+  frame.accelerate(*model, h);
+  quiver::rt::solveContacts(*this, h);
+  frame.move(h);
 }
 
 qv_step_status qv_instance::step() {

@@ -7,6 +7,10 @@
 #include "rigid_frame.h"
 
 namespace quiver::rt {
+struct Contact;
+}
+
+namespace quiver::rt {
 
 // The integrator's estimate of the state at the end of the step: each implicit integrator iterates
 // on one of them and derives the others; the explicit one computes them in turn.
@@ -58,6 +62,13 @@ struct qv_instance {
   quiver::rt::EndOfStep end;
   quiver::rt::StepBuffers work;
   quiver::rt::RigidFrame frame;  // in flight (config.free_flight) only
+  const qv_collider* colliders = nullptr;  // the caller's (qv_instance_set_colliders)
+  int colliderCount = 0;
+  quiver::rt::Contact* contacts = nullptr;  // the last step's, config.max_contacts at most (contact.h)
+  int contactCount = 0;
+  int* surfaceVertices = nullptr;  // in flight: the contact points
+  int surfaceCount = 0;
+  double contactSlop = 0;          // m: penetration left alone
 
   void carve(quiver::rt::BlockCarver& c);
   void rest();

@@ -159,13 +159,16 @@ void RigidFrame::addInertialForces(const qv_model& model, double h, double* redu
     }
 }
 
-void RigidFrame::advance(const qv_model& model, double h) {
+void RigidFrame::accelerate(const qv_model& model, double h) {
   const double mass = model.info.total_mass;
   for (int a = 0; a < 3; ++a) {
     velocity[a] += h * (force[a] / mass + gravity[a]);
-    position[a] += h * velocity[a];
     angularMomentum[a] += h * torque[a];
   }
+}
+
+void RigidFrame::move(double h) {
+  for (int a = 0; a < 3; ++a) position[a] += h * velocity[a];
   // R <- exp(h omega) R by the implicit midpoint rule: omega is what L gives at the midpoint
   // orientation exp(h omega / 2) R (fixed-point iterations, I(q) and h of the step's start). The
   // explicit turn (omega of the start) drifts toward the axis of least inertia, gaining energy;
@@ -210,6 +213,15 @@ void RigidFrame::toWorld(const double p[3], double out[3]) const {
 }
 
 void RigidFrame::toBody(const double f[3], double out[3]) const { rotateBack(rotation, f, out); }
+
+void RigidFrame::toWorldDirection(const double v[3], double out[3]) const { rotate(rotation, v, out); }
+
+void RigidFrame::inverseInertia(const double w[3], double out[3]) const {
+  double body[3], x[3];
+  rotateBack(rotation, w, body);
+  solve3(inertia, body, x);
+  rotate(rotation, x, out);
+}
 
 double RigidFrame::kineticEnergy(const qv_model& model) const {
   double spin = 0;

@@ -63,14 +63,19 @@ struct RigidFrame {
   double addCentrifugal(const qv_model& model, const double* q, double* resisting, double* jacobian) const;
   // Adds the Euler force -U^T M (omega' x p) on q (refresh() first), with omega' over `h`.
   void addInertialForces(const qv_model& model, double h, double* reducedForce) const;
-  // The frame's share of the step: momenta by this step's force, torque and gravity, then x and R.
-  void advance(const qv_model& model, double h);
+  // The frame's share of the step: momenta by this step's force, torque and gravity (accelerate),
+  // then x and R (move); contact impulses go between the two.
+  void accelerate(const qv_model& model, double h);
+  void move(double h);
   // Orientation `from` turned by t |omega| about the world axis omega.
   void turn(const double from[4], const double omega[3], double t);
   // World position of body point p: x + R p.
   void toWorld(const double p[3], double out[3]) const;
-  // Body direction of world vector f: R^T f.
+  // Body direction of world vector f: R^T f; and back, R v.
   void toBody(const double f[3], double out[3]) const;
+  void toWorldDirection(const double v[3], double out[3]) const;
+  // The world's inverse inertia on w, R I^-1 R^T w (I of the last refresh()).
+  void inverseInertia(const double w[3], double out[3]) const;
   // Kinetic energy of the frame's motion and its coupling to q': m |v|^2 / 2 + omega . (I omega / 2
   // + h) (refresh() first); with |q'|^2 / 2 the body's whole kinetic energy.
   double kineticEnergy(const qv_model& model) const;

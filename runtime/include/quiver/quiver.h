@@ -183,6 +183,7 @@ typedef struct qv_instance_config {
                                 the instance; default 100 x the model's diagonal */
   qv_elasticity elasticity;  /* default QV_ELASTICITY_STVK */
   int free_flight;           /* 1: the object flies in a moving frame (qv_rigid_state; needs has_rigid_body); default 0 */
+  int max_contacts;          /* in flight: contact points solved per step, 0..4096 (the deepest kept); default 64 */
 } qv_instance_config;
 
 /* Defaults for `model` (pass NULL for model-independent defaults). */
@@ -267,6 +268,41 @@ typedef struct qv_rigid_state {
 /* QV_ERROR_INVALID_ARGUMENT for an instance that does not fly or non-finite values. */
 QV_API qv_result qv_instance_get_rigid_state(const qv_instance* instance, qv_rigid_state* state);
 QV_API qv_result qv_instance_set_rigid_state(qv_instance* instance, const qv_rigid_state* state);
+
+/* Colliders: static or moved by the game between steps. A flying instance touches them with its surface
+   vertices: each step, velocity-level impulses on its frame (restitution, Coulomb friction; stiff at any time
+   step; at rest it sinks by a slop of 1e-3 of the model's diagonal plus what the contacts' slight softness
+   gives: 3e-3 of it on tests/runtime/contact_test.cpp's bar at 1/60 s), and the same forces on its
+   deformation. Nothing moving faster than the step can see tunnels: a vertex is caught while its frame's
+   motion can reach the collider within the step; a collider thinner than the spacing of the object's
+   surface vertices can pass between them. */
+typedef enum qv_collider_type {
+  QV_COLLIDER_PLANE = 0,   /* data: nx, ny, nz, d: the points with n . x = d; the object stays on the side n points to */
+  QV_COLLIDER_SPHERE = 1,  /* data: x, y, z, radius */
+  QV_COLLIDER_BOX = 2,     /* data: cx, cy, cz, hx, hy, hz: axis-aligned, centre and half extents */
+  QV_COLLIDER_CAPSULE = 3  /* data: x0, y0, z0, x1, y1, z1, radius: the points within radius of the segment */
+} qv_collider_type;
+typedef struct qv_collider {
+  qv_collider_type type;
+  double data[8];      /* m, as the type says; unused entries must be finite */
+  double friction;     /* Coulomb coefficient mu, >= 0 */
+  double restitution;  /* 0 (no bounce) .. 1 (elastic) */
+} qv_collider;
+/* The colliders a flying instance meets, `count` of them at `colliders`: kept by pointer (the caller keeps
+   the array alive and may change it between steps; each step reads it). QV_ERROR_INVALID_ARGUMENT for an
+   instance that does not fly or an invalid collider (the colliders are left as they were). NULL, 0: none. */
+QV_API qv_result qv_instance_set_colliders(qv_instance* instance, const qv_collider* colliders, int count);
+/* The last step's contacts: where, the collider's outward normal, and the impulse it gave (N s, world). */
+typedef struct qv_contact {
+  int vertex;
+  int collider;       /* index into the array given to qv_instance_set_colliders */
+  double point[3];    /* m, the vertex at the step's start */
+  double normal[3];
+  double impulse[3];  /* over the step: divide by the time step for the force */
+  double depth;       /* signed distance at the step's start: negative where it penetrated */
+} qv_contact;
+/* Copies up to `capacity` of the last step's contacts into `contacts`; returns how many there were. */
+QV_API int qv_instance_contacts(const qv_instance* instance, qv_contact* contacts, int capacity);
 
 /* Largest stable time step of central differences at rest (2 / omega_max), s. */
 QV_API double qv_instance_stable_time_step(const qv_instance* instance);

@@ -1,0 +1,192 @@
+// Contact of a flying bar with colliders, against mechanics worked by hand: at rest on a plane the
+// contacts carry exactly its weight; sliding stops after v0 / (mu g); a bounce never gains energy;
+// the colliders' signed distances against geometry; bad colliders refused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "free_bar.h"
+#include "runtime/src/contact.h"
+#include "runtime_fixture.h"
+
+namespace quiver {
+namespace {
+
+using test::FreeBar;
+
+constexpr double kG = QV_STANDARD_GRAVITY;
+
+qv_collider ground(double friction, double restitution) {
+  return qv_collider{QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, friction, restitution};
+}
+
+struct Dropped {
+  FreeBar bar;
+  std::unique_ptr<test::Instance> inst;
+  std::vector<qv_collider> colliders;
+  double h;
+  Dropped(double step, std::vector<qv_collider> world, const qv_rigid_state& start, double alpha = 5) : colliders(world), h(step) {
+    qv_instance_config c = bar.config(h);
+    c.rayleigh_alpha = alpha;
+    inst = std::make_unique<test::Instance>(bar.model, c);
+    EXPECT_EQ(qv_instance_set_rigid_state(inst->s, &start), QV_OK);
+    const double g[3] = {0, 0, -kG};
+    qv_instance_set_gravity(inst->s, g);
+    EXPECT_EQ(qv_instance_set_colliders(inst->s, colliders.data(), static_cast<int>(colliders.size())), QV_OK);
+  }
+  qv_rigid_state state() const {
+    qv_rigid_state s;
+    qv_instance_get_rigid_state(inst->s, &s);
+    return s;
+  }
+  // The last step's contact force (N) and deepest penetration (m, > 0 when penetrating).
+  void contactForce(double force[3], double& penetration) const {
+    std::vector<qv_contact> contacts(64);
+    const int n = qv_instance_contacts(inst->s, contacts.data(), 64);
+    force[0] = force[1] = force[2] = 0;
+    penetration = 0;
+    for (int j = 0; j < std::min(n, 64); ++j) {
+      for (int a = 0; a < 3; ++a) force[a] += contacts[j].impulse[a] / h;
+      penetration = std::max(penetration, -contacts[j].depth);
+    }
+  }
+};
+
+TEST(Contact, AtRestOnAPlaneItCarriesExactlyItsWeight) {
+  // Lying flat, its underside 2 cm above the ground.
+  Dropped d(1.0 / 60, {ground(0.5, 0)}, {{0.3, 0.05, 0.07}, {1, 0, 0, 0}, {0, 0, 0}, {0, 0, 0}});
+  double deepest = 0;
+  for (int i = 0; i < 180; ++i) {
+    ASSERT_NE(qv_instance_step(d.inst->s), QV_STEP_RESET);
+    double f[3], pen;
+    d.contactForce(f, pen);
+    deepest = std::max(deepest, pen);
+  }
+  const qv_rigid_state before = d.state();
+  double mean = 0;
+  for (int i = 0; i < 60; ++i) {
+    ASSERT_NE(qv_instance_step(d.inst->s), QV_STEP_RESET);
+    double f[3], pen;
+    d.contactForce(f, pen);
+    mean += f[2] / 60;
+    deepest = std::max(deepest, pen);
+  }
+  const qv_rigid_state after = d.state();
+  const double weight = d.bar.info.total_mass * kG;
+  double creep = 0;
+  for (int a = 0; a < 3; ++a) creep += std::pow(after.position[a] - before.position[a], 2);
+  std::printf("at rest: contact force %.6g N for a weight of %.6g N, creep %.3g m/s, deepest penetration %.3g m\n", mean,
+              weight, std::sqrt(creep), deepest);
+  EXPECT_NEAR(mean, weight, 1e-3 * weight);
+  EXPECT_LT(std::sqrt(creep), 1e-4);                 // over the last second
+  EXPECT_LT(deepest, 3e-3 * 0.62);                   // 3x the slop of 1e-3 of the diagonal (measured 2.7x)
+  EXPECT_NEAR(after.position[2], 0.05, 3e-3 * 0.62);  // resting on its underside
+}
+
+TEST(Contact, SlidingStopsAfterV0OverMuG) {
+  const double mu = 0.4, v0 = 2;
+  Dropped d(1.0 / 120, {ground(mu, 0)}, {{0.3, 0.05, 0.05}, {1, 0, 0, 0}, {v0, 0, 0}, {0, 0, 0}});
+  double stopped = -1;
+  for (int i = 1; i <= 240 && stopped < 0; ++i) {
+    ASSERT_NE(qv_instance_step(d.inst->s), QV_STEP_RESET);
+    if (d.state().linear_velocity[0] < 1e-3) stopped = i * d.h;
+  }
+  const double expected = v0 / (mu * kG);
+  std::printf("sliding at %.1f m/s with mu %.1f: stopped after %.4f s, v0 / (mu g) = %.4f s\n", v0, mu, stopped, expected);
+  EXPECT_NEAR(stopped, expected, 0.03 * expected);
+}
+
+// Energy (frame and deformation, kinetic, elastic and gravity's) over `steps` steps: at the start, the
+// highest, and how high the centre rose after the first contact.
+struct Bounce {
+  double start = 0, highest = 0, end = 0, rise = 0;
+};
+Bounce bounce(Dropped& d, int steps) {
+  const double m = d.bar.info.total_mass;
+  const auto energy = [&] {
+    double kinetic = 0, elastic = 0;
+    qv_instance_energies(d.inst->s, &kinetic, &elastic);
+    return kinetic + elastic + m * kG * d.state().position[2];
+  };
+  Bounce b;
+  b.start = b.highest = energy();
+  double lowest = INFINITY;
+  bool touched = false;
+  for (int i = 0; i < steps; ++i) {
+    EXPECT_NE(qv_instance_step(d.inst->s), QV_STEP_RESET);
+    touched = touched || qv_instance_contacts(d.inst->s, nullptr, 0) > 0;
+    b.highest = std::max(b.highest, energy());
+    const double z = d.state().position[2];
+    if (touched) lowest = std::min(lowest, z), b.rise = std::max(b.rise, z - lowest);
+  }
+  b.end = energy();
+  return b;
+}
+
+TEST(Contact, ABounceNeverGainsEnergy) {
+  // Flat onto the ground from 0.3 m: the centre comes back up by about e^2 of the fall.
+  const double e = 0.8, fall = 0.3;
+  Dropped flat(1.0 / 120, {ground(0.3, e)}, {{0.3, 0.05, 0.05 + fall}, {1, 0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, 0);
+  const Bounce b = bounce(flat, 240);
+  std::printf("flat drop, restitution %.1f: energy %.4g J at the start, at most %+.2e relative above it, %.4g J after 2 s; "
+              "rebound %.3g m of a %.2g m fall (e^2: %.3g)\n", e, b.start, b.highest / b.start - 1, b.end, b.rise, fall,
+              e * e * fall);
+  EXPECT_LE(b.highest, b.start * (1 + 1e-3));
+  EXPECT_GT(b.rise, 0.7 * e * e * fall);
+  EXPECT_LT(b.rise, 1.15 * e * e * fall);  // from its lowest, where it squashed
+  // Tumbling onto the ground and a sphere: corners, spin, two colliders.
+  Dropped tumbling(1.0 / 120, {ground(0.3, e), qv_collider{QV_COLLIDER_SPHERE, {1.2, 0.05, 0.2, 0.3, 0, 0, 0, 0}, 0.3, e}},
+                   {{0.3, 0.05, 0.6}, {0.96, 0.1, 0.2, 0.15}, {1.5, 0, 0}, {0, 1, 0}}, 0);
+  const Bounce t = bounce(tumbling, 360);
+  std::printf("tumbling drop: energy %.4g J at the start, at most %+.2e relative above it, %.4g J after 3 s\n", t.start,
+              t.highest / t.start - 1, t.end);
+  EXPECT_LE(t.highest, t.start * (1 + 1e-3));
+}
+
+TEST(Contact, CollidersMeasureDistanceAsGeometrySays) {
+  double d, n[3];
+  const double p[3] = {1, 2, 3};
+  ASSERT_TRUE(rt::colliderDistance({QV_COLLIDER_PLANE, {0, 0, 2, 2, 0, 0, 0, 0}, 0, 0}, p, d, n));
+  EXPECT_DOUBLE_EQ(d, 2);  // z = 1, normal +z
+  EXPECT_EQ(n[2], 1);
+  ASSERT_TRUE(rt::colliderDistance({QV_COLLIDER_SPHERE, {1, 2, 0, 1, 0, 0, 0, 0}, 0, 0}, p, d, n));
+  EXPECT_DOUBLE_EQ(d, 2);
+  ASSERT_TRUE(rt::colliderDistance({QV_COLLIDER_BOX, {0, 0, 0, 2, 3, 1, 0, 0}, 0, 0}, p, d, n));
+  EXPECT_DOUBLE_EQ(d, 2);  // above the top face z = 1, inside in x and y
+  EXPECT_EQ(n[2], 1);
+  const double inside[3] = {1.5, 0, 0};
+  ASSERT_TRUE(rt::colliderDistance({QV_COLLIDER_BOX, {0, 0, 0, 2, 3, 1, 0, 0}, 0, 0}, inside, d, n));
+  EXPECT_DOUBLE_EQ(d, -0.5);  // nearest face x = 2
+  EXPECT_EQ(n[0], 1);
+  ASSERT_TRUE(rt::colliderDistance({QV_COLLIDER_BOX, {0, 0, 0, 0.5, 1, 2, 0, 0}, 0, 0}, p, d, n));
+  EXPECT_DOUBLE_EQ(d, std::sqrt(0.25 + 1 + 1));  // past a corner
+  ASSERT_TRUE(rt::colliderDistance({QV_COLLIDER_CAPSULE, {0, 2, 3, 0, 2, 10, 0.5, 0}, 0, 0}, p, d, n));
+  EXPECT_DOUBLE_EQ(d, 0.5);  // beside the segment
+  ASSERT_TRUE(rt::colliderDistance({QV_COLLIDER_CAPSULE, {0, 2, 5, 0, 2, 10, 0.5, 0}, 0, 0}, p, d, n));
+  EXPECT_DOUBLE_EQ(d, std::sqrt(5.0) - 0.5);  // past its end cap
+}
+
+TEST(Contact, BadCollidersAndGroundedInstancesAreRefused) {
+  FreeBar bar;
+  test::Instance flying(bar.model, bar.config(1.0 / 60));
+  const qv_collider bad[] = {{QV_COLLIDER_PLANE, {0, 0, 0, 1, 0, 0, 0, 0}, 0.5, 0},
+                             {QV_COLLIDER_SPHERE, {0, 0, 0, -1, 0, 0, 0, 0}, 0.5, 0},
+                             {QV_COLLIDER_BOX, {0, 0, 0, 1, 1, 0, 0, 0}, 0.5, 0},
+                             {QV_COLLIDER_CAPSULE, {0, 0, 0, 1, 1, 1, 0, 0}, 0.5, 0},
+                             {QV_COLLIDER_SPHERE, {0, NAN, 0, 1, 0, 0, 0, 0}, 0.5, 0},
+                             {QV_COLLIDER_SPHERE, {0, 0, 0, 1, 0, 0, 0, 0}, -1, 0},
+                             {QV_COLLIDER_SPHERE, {0, 0, 0, 1, 0, 0, 0, 0}, 0.5, 1.5},
+                             {static_cast<qv_collider_type>(9), {0, 0, 0, 1, 0, 0, 0, 0}, 0.5, 0}};
+  for (const qv_collider& c : bad) EXPECT_EQ(qv_instance_set_colliders(flying.s, &c, 1), QV_ERROR_INVALID_ARGUMENT);
+  const qv_collider good = ground(0.5, 0);
+  EXPECT_EQ(qv_instance_set_colliders(flying.s, &good, 1), QV_OK);
+  EXPECT_EQ(qv_instance_set_colliders(flying.s, nullptr, 0), QV_OK);
+  qv_instance_config c = bar.config(1.0 / 60);
+  c.free_flight = 0;
+  test::Instance grounded(bar.model, c);
+  EXPECT_EQ(qv_instance_set_colliders(grounded.s, &good, 1), QV_ERROR_INVALID_ARGUMENT);
+}
+
+} // namespace
+} // namespace quiver
