@@ -1,5 +1,6 @@
 #include "apps/runtime_target.h"
 
+#include <algorithm>
 #include <iostream>
 #include <stdexcept>
 
@@ -27,6 +28,14 @@ void RuntimeTarget::startFlight(const SimOptions& o) {
   }
   if (qv_instance_set_rigid_state(instance_.get(), &state) != QV_OK)
     throw std::runtime_error("--position, --velocity and --angular-velocity must be finite");
+  for (const std::string& text : o.colliders) {
+    colliders_.push_back(parseCollider(text, o.friction, o.restitution));
+    if (qv_instance_set_colliders(instance_.get(), &colliders_.back(), 1) != QV_OK)
+      throw std::runtime_error("--collider '" + text + "': sizes must be positive, a plane's normal not zero");
+  }
+  if (qv_instance_set_colliders(instance_.get(), colliders_.data(), static_cast<int>(colliders_.size())) != QV_OK)
+    throw std::runtime_error("--friction and --restitution: mu >= 0, restitution in 0..1");
+  contacts_.resize(static_cast<size_t>(instance_.config().max_contacts));
 }
 
 void RuntimeTarget::setGravity(const double g[3]) { qv_instance_set_gravity(instance_.get(), g); }
@@ -46,6 +55,9 @@ int RuntimeTarget::step(int& newton) {
   indefinite_ += status == QV_STEP_INDEFINITE;
   heldBack_ += report.held_back;
   energyRemoved_ += report.energy_removed;
+  const int touching = std::min(qv_instance_contacts(instance_.get(), contacts_.data(), static_cast<int>(contacts_.size())),
+                                static_cast<int>(contacts_.size()));
+  for (int j = 0; j < touching; ++j) maxPenetration_ = std::max(maxPenetration_, -contacts_[j].depth);
   return status == QV_STEP_RESET ? 1 : 0;
 }
 

@@ -25,12 +25,16 @@ public:
   int indefiniteSteps() const { return indefinite_; }
   int heldBackSteps() const { return heldBack_; }
   double energyRemoved() const { return energyRemoved_; }  // J, by the minimising solver's energy budget
+  double maxPenetration() const { return maxPenetration_; }  // m, the deepest contact seen
 
 private:
   const RuntimeModel& model_;
   RuntimeInstance instance_;
   int indefinite_ = 0, heldBack_ = 0;
   double energyRemoved_ = 0;
+  std::vector<qv_collider> colliders_;  // the instance reads them by pointer
+  std::vector<qv_contact> contacts_;
+  double maxPenetration_ = 0;
 };
 
 } // namespace quiver::app

@@ -36,6 +36,7 @@ int simulateModel(const std::string& path, const SimOptions& o) {
       const double* v = flight.linear_velocity;
       j["final_center"] = {flight.position[0], flight.position[1], flight.position[2]};  // world centre of mass, m
       j["final_speed_mps"] = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      j["max_penetration_m"] = target.maxPenetration();
     }
     std::cout << j.dump(1) << "\n";
   } else {

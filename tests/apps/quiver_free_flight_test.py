@@ -60,6 +60,30 @@ class FreeFlight(unittest.TestCase):
         self.assertAlmostEqual(j["final_speed_mps"], np.linalg.norm([1, 0.5, 3 - g * t]), places=9)
         self.assertEqual(j["resets"], 0)
 
+    def test_dropped_on_the_ground_it_comes_to_rest(self):
+        p = run(QUIVER, "sim", self.free + ".qvr", "--free", "--gravity", "--position", "0,0,0.5", "--angular-velocity",
+                "1,2,0", "--collider", "plane:0,0,1,0", "--collider", "sphere:0.8,0.05,0.1,0.2", "--restitution", 0.3,
+                "--alpha", 5, "--steps", 300, "--hold", 0, "--json")
+        j = json.loads(p.stdout)
+        print(f"dropped on a plane and a sphere: rests at {j['final_center']}, {j['final_speed_mps']:.2g} m/s, "
+              f"deepest {j['max_penetration_m'] * 1000:.2g} mm")
+        self.assertLess(j["final_speed_mps"], 0.01)
+        # Landing at 3 m/s at 1/60 s, the soft (1 MPa) bar's contact vertices sink up to ~10 mm while its
+        # deformation takes the impact (the frame itself stops at the slop); at rest, ~1 mm (tests/runtime/contact_test.cpp).
+        self.assertLess(j["max_penetration_m"], 0.015)
+        self.assertGreater(j["final_center"][2], 0.04)  # on the ground (its half height is 0.05), not through it
+        self.assertLess(j["final_center"][2], 0.3)
+        self.assertEqual(j["resets"], 0)
+
+    def test_bad_colliders_are_named(self):
+        for value, message in (("mesh:x.obj", "mesh colliders are not there yet"), ("sphere:1,2,3", "expected sphere:x,y,z,radius"),
+                               ("sphere:1,2,3,-1", "sizes must be positive"), ("plane:0,0,0,1", "normal not zero"),
+                               ("box:1,2,3,a,1,1", "expected box:cx,cy,cz,hx,hy,hz"), ("cone:1", "plane, sphere, box or capsule")):
+            with self.subTest(value=value):
+                p = run(QUIVER, "sim", self.free + ".qvr", "--free", "--collider", value, "--steps", 2, codes=(1,))
+                self.assertIn(message, p.stderr)
+                self.assertIn(value, p.stderr)
+
     def test_what_needs_free_says_so(self):
         p = run(QUIVER, "sim", self.free + ".qvr", "--velocity", "1,0,0", "--steps", 2, codes=(1,))
         self.assertIn("need --free", p.stderr)
