@@ -1,10 +1,12 @@
 // `quiver render`: headless pictures of a model, drawn by the software rasterizer: the rest shape,
 // the shape a scenario leaves (or its whole run, animated), or a grid of the first linear modes
 // (or basis vectors), still or oscillating.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
+#include "apps/render/collider_mesh.h"
 #include "apps/render/frame_writer.h"
 #include "apps/render/software_renderer.h"
 #include "apps/runtime_target.h"
@@ -16,7 +18,7 @@ namespace quiver::app {
 
 namespace {
 
-constexpr std::array<uint8_t, 3> kWhite{255, 255, 255}, kSteel{70, 130, 180};
+constexpr std::array<uint8_t, 3> kWhite{255, 255, 255}, kSteel{70, 130, 180}, kStone{200, 196, 188};
 constexpr int kFramesPerOscillation = 30;
 
 // The box the pictures frame: the rest box grown by `margin` of its diagonal on every side, so that
@@ -33,6 +35,37 @@ Image picture(const Camera& cam, int width, int height, const std::vector<float>
   image.clear(kWhite);
   drawTriangles(image, cam, positions, triangles, kSteel);
   return image;
+}
+
+// Free flight: runs the scenario keeping the frames, then draws them with the colliders under one
+// camera that frames the whole flight (the object leaves its rest box).
+void renderFlight(const RuntimeModel& model, const RenderOptions& o, int width, int height) {
+  RuntimeTarget target(model, o.scenario.step);
+  FrameWriter frames(o.output, o.every * target.timeStep());
+  std::vector<std::vector<float>> shots;
+  const auto keep = [&] { shots.push_back(target.instance().positions()); };
+  if (frames.animated()) keep();
+  runScenario(target, model.mesh(), o.scenario, [&](int step) {
+    if (frames.animated() ? step % o.every == 0 : step == o.scenario.steps) keep();
+  });
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+  for (const auto& p : shots)
+    for (size_t v = 0; v < p.size() / 3; ++v)
+      for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], double(p[3 * v + a])), hi[a] = std::max(hi[a], double(p[3 * v + a]));
+  const Eigen::Vector3d grow = Eigen::Vector3d::Constant(0.1 * (hi - lo).norm());
+  TriangleSoup world;
+  for (const std::string& text : o.scenario.colliders)
+    appendCollider(parseCollider(text, o.scenario.friction, o.scenario.restitution), lo, hi, world);
+  const Camera cam = Camera::framing(lo - grow, hi + grow, width, height);
+  const std::vector<unsigned> triangles = model.triangles();
+  for (const auto& p : shots) {
+    Image image(width, height);
+    image.clear(kWhite);
+    drawTriangles(image, cam, world.positions, world.triangles, kStone);
+    drawTriangles(image, cam, p, triangles, kSteel);
+    frames.add(image);
+  }
+  frames.finish();
 }
 
 // Grid of the first `count` linear modes (or basis vectors), each scaled so that its largest vertex
@@ -107,6 +140,10 @@ int renderModel(const std::string& path, const RenderOptions& o) {
     for (int f = 0; frames.animated() && f < kFramesPerOscillation; ++f)
       frames.add(grid.draw(std::sin(2 * M_PI * f / kFramesPerOscillation)));
     frames.finish();
+    return 0;
+  }
+  if (o.scenario.step.freeFlight) {
+    renderFlight(model, o, width, height);
     return 0;
   }
   RuntimeTarget target(model, o.scenario.step);
