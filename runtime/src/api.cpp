@@ -366,7 +366,7 @@ int qv_instance_contacts(const qv_instance* s, qv_contact* out, int capacity) {
     qv_contact& o = out[j];
     o.vertex = c.vertex;
     o.collider = c.collider;
-    o.depth = c.depth;
+    o.depth = c.deformedDepth;
     for (int a = 0; a < 3; ++a) {
       o.point[a] = c.point[a];
       o.normal[a] = c.normal[a];

@@ -117,12 +117,15 @@ void solveContacts(qv_instance& s, double h) {
   const double g = std::sqrt(dot3(f.gravity, f.gravity));
   const double bounceSpeed = 2 * g * h + 1e-3;  // slower approaches rest instead of bouncing
 
-  // Contacts: each surface vertex against each collider, the deepest kept when there are too many.
+  // Contacts: each surface vertex of the rest shape carried by the frame against each collider, the
+  // deepest kept when there are too many. Found and solved on the rigid shape: the deformation takes
+  // the forces but does not move the contacts (taking its vertices made the loads on q and the
+  // contacts chase each other: a resting bar fluttered, bent 1.5 cm, its contacts hopping between
+  // its ends and its middle every few steps).
   for (int i = 0; i < s.surfaceCount; ++i) {
     const int v = s.surfaceVertices[i];
-    double u[3], body[3], p[3];
-    m.vertexLinear(v, s.q, u, nullptr);
-    for (int a = 0; a < 3; ++a) body[a] = m.rest[3 * v + a] - c[a] + u[a];
+    double body[3], p[3];
+    for (int a = 0; a < 3; ++a) body[a] = m.rest[3 * v + a] - c[a];
     f.toWorld(body, p);
     for (int k = 0; k < s.colliderCount; ++k) {
       double depth, normal[3];
@@ -141,6 +144,12 @@ void solveContacts(qv_instance& s, double h) {
       ct.vertex = v;
       ct.collider = k;
       ct.depth = depth;
+      // What the caller sees: the deformed vertex's own distance (the deformation adds to the frame's).
+      double u[3], deformed[3], world[3], n[3];
+      m.vertexLinear(v, s.q, u, nullptr);
+      for (int a = 0; a < 3; ++a) deformed[a] = body[a] + u[a];
+      f.toWorld(deformed, world);
+      colliderDistance(s.colliders[k], world, ct.deformedDepth, n);
       for (int a = 0; a < 3; ++a) {
         ct.point[a] = p[a];
         ct.normal[a] = normal[a];

@@ -26,7 +26,8 @@ struct Contact {
   int vertex = 0, collider = 0;
   double point[3] = {}, normal[3] = {};
   double arm[3] = {};        // point - x
-  double depth = 0;          // signed distance (negative: penetrating)
+  double depth = 0;          // signed distance of the rigid shape's vertex (negative: penetrating)
+  double deformedDepth = 0;  // of the deformed vertex, reported
   double target = 0;         // the normal velocity the impulse aims at
   double bounce = 0;         // restitution x the approach speed: the target once the contact holds
   double normalImpulse = 0;  // accumulated, N s

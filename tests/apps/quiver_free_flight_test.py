@@ -68,9 +68,9 @@ class FreeFlight(unittest.TestCase):
         print(f"dropped on a plane and a sphere: rests at {j['final_center']}, {j['final_speed_mps']:.2g} m/s, "
               f"deepest {j['max_penetration_m'] * 1000:.2g} mm")
         self.assertLess(j["final_speed_mps"], 0.01)
-        # Landing at 3 m/s at 1/60 s, the soft (1 MPa) bar's contact vertices sink up to ~10 mm while its
+        # Landing at 3 m/s at 1/60 s, the soft (1 MPa) bar's deformed vertices sink up to 2.5 mm while the
         # deformation takes the impact (the frame itself stops at the slop); at rest, ~1 mm (tests/runtime/contact_test.cpp).
-        self.assertLess(j["max_penetration_m"], 0.015)
+        self.assertLess(j["max_penetration_m"], 0.005)
         self.assertGreater(j["final_center"][2], 0.04)  # on the ground (its half height is 0.05), not through it
         self.assertLess(j["final_center"][2], 0.3)
         self.assertEqual(j["resets"], 0)

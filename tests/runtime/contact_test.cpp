@@ -26,7 +26,9 @@ struct Dropped {
   std::unique_ptr<test::Instance> inst;
   std::vector<qv_collider> colliders;
   double h;
-  Dropped(double step, std::vector<qv_collider> world, const qv_rigid_state& start, double alpha = 5) : colliders(world), h(step) {
+  Dropped(double step, std::vector<qv_collider> world, const qv_rigid_state& start, double alpha = 5,
+          std::array<int, 3> cells = {6, 1, 1})
+      : bar(16, cells), colliders(world), h(step) {
     qv_instance_config c = bar.config(h);
     c.rayleigh_alpha = alpha;
     inst = std::make_unique<test::Instance>(bar.model, c);
@@ -55,13 +57,13 @@ struct Dropped {
 
 TEST(Contact, AtRestOnAPlaneItCarriesExactlyItsWeight) {
   // Lying flat, its underside 2 cm above the ground.
-  Dropped d(1.0 / 60, {ground(0.5, 0)}, {{0.3, 0.05, 0.07}, {1, 0, 0, 0}, {0, 0, 0}, {0, 0, 0}});
-  double deepest = 0;
+  Dropped d(1.0 / 60, {ground(0.5, 0)}, {{0.3, 0.05, 0.07}, {1, 0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, 5, {12, 2, 2});
+  double landing = 0, deepest = 0;  // the deepest any deformed vertex sinks, landing and at rest
   for (int i = 0; i < 180; ++i) {
     ASSERT_NE(qv_instance_step(d.inst->s), QV_STEP_RESET);
     double f[3], pen;
     d.contactForce(f, pen);
-    deepest = std::max(deepest, pen);
+    landing = std::max(landing, pen);
   }
   const qv_rigid_state before = d.state();
   double mean = 0;
@@ -76,12 +78,22 @@ TEST(Contact, AtRestOnAPlaneItCarriesExactlyItsWeight) {
   const double weight = d.bar.info.total_mass * kG;
   double creep = 0;
   for (int a = 0; a < 3; ++a) creep += std::pow(after.position[a] - before.position[a], 2);
-  std::printf("at rest: contact force %.6g N for a weight of %.6g N, creep %.3g m/s, deepest penetration %.3g m\n", mean,
-              weight, std::sqrt(creep), deepest);
+  std::printf("at rest: contact force %.6g N for a weight of %.6g N, creep %.3g m/s, deepest penetration %.3g m "
+              "(landing %.3g m)\n", mean, weight, std::sqrt(creep), deepest, landing);
   EXPECT_NEAR(mean, weight, 1e-3 * weight);
-  EXPECT_LT(std::sqrt(creep), 1e-4);                 // over the last second
-  EXPECT_LT(deepest, 3e-3 * 0.62);                   // 3x the slop of 1e-3 of the diagonal (measured 2.7x)
+  EXPECT_LT(std::sqrt(creep), 5e-4);                 // over the last second
+  EXPECT_LT(deepest, 5e-3 * 0.62);                   // the slop (1e-3 of the diagonal), the softness, the deformation
+  EXPECT_LT(landing, 6e-3 * 0.62);
   EXPECT_NEAR(after.position[2], 0.05, 3e-3 * 0.62);  // resting on its underside
+  // Flat on the ground: its underside straight (a flutter between loaded ends and loaded middle once
+  // bent it by 1.5 cm).
+  const Eigen::MatrixXd x = d.bar.positions(d.inst->s);
+  const double* rest = qv_model_rest_positions(d.bar.model);
+  double low = INFINITY, high = -INFINITY;
+  for (int v = 0; v < d.bar.info.vertex_count; ++v)
+    if (rest[3 * v + 2] < 1e-9) low = std::min(low, x(v, 2)), high = std::max(high, x(v, 2));
+  std::printf("its underside between z = %.4g and %.4g m\n", low, high);
+  EXPECT_LT(high - low, 2e-3);
 }
 
 TEST(Contact, SlidingStopsAfterV0OverMuG) {

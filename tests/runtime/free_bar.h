@@ -1,6 +1,7 @@
 #pragma once
 // A free 0.6 x 0.1 x 0.1 bar (tests/support/small_model.h, free), loaded from memory, with the mesh's
 // consistent mass to measure what the runtime hands out: centre of mass, momentum.
+#include <array>
 #include <string>
 #include <vector>
 
@@ -22,9 +23,9 @@ struct FreeBar {
   qv_model_info info{};
   Eigen::SparseMatrix<double> mass;  // n x n, the consistent mass's x-x block
 
-  explicit FreeBar(int rank = 10) {
+  explicit FreeBar(int rank = 10, std::array<int, 3> cells = {6, 1, 1}) {
     test::SmallModelSpec spec;
-    spec.cells = {6, 1, 1};
+    spec.cells = cells;
     spec.free = true;
     spec.rank = rank;
     spec.youngsModulus = kE;

@@ -271,9 +271,9 @@ QV_API qv_result qv_instance_set_rigid_state(qv_instance* instance, const qv_rig
 
 /* Colliders: static or moved by the game between steps. A flying instance touches them with its surface
    vertices: each step, velocity-level impulses on its frame (restitution, Coulomb friction; stiff at any time
-   step; at rest it sinks by a slop of 1e-3 of the model's diagonal plus what the contacts' slight softness
-   gives: 3e-3 of it on tests/runtime/contact_test.cpp's bar at 1/60 s), and the same forces on its
-   deformation. Nothing moving faster than the step can see tunnels: a vertex is caught while its frame's
+   step), found and solved on the rigid shape it carries, and the same forces on its deformation. At rest a
+   vertex sinks by a slop of 1e-3 of the model's diagonal, the contacts' slight softness and its own
+   deformation: 2.2 mm (3.6e-3 of the diagonal) on tests/runtime/contact_test.cpp's soft bar at 1/60 s. Nothing moving faster than the step can see tunnels: a vertex is caught while its frame's
    motion can reach the collider within the step; a collider thinner than the spacing of the object's
    surface vertices can pass between them. */
 typedef enum qv_collider_type {
@@ -299,7 +299,9 @@ typedef struct qv_contact {
   double point[3];    /* m, the vertex at the step's start */
   double normal[3];
   double impulse[3];  /* over the step: divide by the time step for the force */
-  double depth;       /* signed distance at the step's start: negative where it penetrated */
+  double depth;       /* the deformed vertex's signed distance at the step's start: negative where it penetrated
+                         (contacts are found and solved on the rigid shape the frame carries; the deformation
+                         takes their forces and may sink a vertex by its own displacement) */
 } qv_contact;
 /* Copies up to `capacity` of the last step's contacts into `contacts`; returns how many there were. */
 QV_API int qv_instance_contacts(const qv_instance* instance, qv_contact* contacts, int capacity);
