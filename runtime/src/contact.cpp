@@ -104,15 +104,8 @@ void solveContacts(qv_instance& s, double h) {
   const double* c = m.rigidBody;
   double omega[3];
   f.worldOmega(omega);
-  // A step's reach: how far the frame's motion can carry a vertex, plus the slop.
-  double reach = 0;
-  for (int i = 0; i < s.surfaceCount; ++i) {
-    double u[3], p[3];
-    m.vertexLinear(s.surfaceVertices[i], s.q, u, nullptr);
-    for (int a = 0; a < 3; ++a) p[a] = m.rest[3 * s.surfaceVertices[i] + a] - c[a] + u[a];
-    reach = std::fmax(reach, std::sqrt(dot3(p, p)));
-  }
-  const double speed = std::sqrt(dot3(f.velocity, f.velocity)) + std::sqrt(dot3(omega, omega)) * reach;
+  // How fast the frame can carry a vertex: its reach within the step, plus the slop.
+  const double speed = std::sqrt(dot3(f.velocity, f.velocity)) + std::sqrt(dot3(omega, omega)) * s.surfaceRadius;
   const double slop = s.contactSlop, margin = slop + 2 * h * speed;
   const double g = std::sqrt(dot3(f.gravity, f.gravity));
   const double bounceSpeed = 2 * g * h + 1e-3;  // slower approaches rest instead of bouncing

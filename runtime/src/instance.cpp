@@ -79,7 +79,12 @@ qv_instance* constructInstance(const qv_model& model, const qv_instance_config& 
     for (int v = 0; v < model.info.vertex_count; ++v) s->surfaceVertices[v] = 0;
     for (size_t k = 0; k < 3 * static_cast<size_t>(model.info.triangle_count); ++k) s->surfaceVertices[model.triangles[k]] = 1;
     for (int v = 0; v < model.info.vertex_count; ++v)
-      if (s->surfaceVertices[v]) s->surfaceVertices[s->surfaceCount++] = v;
+      if (s->surfaceVertices[v]) {
+        s->surfaceVertices[s->surfaceCount++] = v;
+        double r2 = 0;
+        for (int a = 0; a < 3; ++a) r2 += std::pow(model.rest[3 * v + a] - model.rigidBody[a], 2);
+        s->surfaceRadius = std::fmax(s->surfaceRadius, std::sqrt(r2));
+      }
     double d2 = 0;
     for (int a = 0; a < 3; ++a) d2 += std::pow(model.info.bbox_max[a] - model.info.bbox_min[a], 2);
     s->contactSlop = 1e-3 * std::sqrt(d2);

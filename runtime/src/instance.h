@@ -68,6 +68,7 @@ struct qv_instance {
   int contactCount = 0;
   int* surfaceVertices = nullptr;  // in flight: the contact points
   int surfaceCount = 0;
+  double surfaceRadius = 0;        // m: the farthest surface vertex from the centre of mass, at rest
   double contactSlop = 0;          // m: penetration left alone
 
   void carve(quiver::rt::BlockCarver& c);
