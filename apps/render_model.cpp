@@ -54,8 +54,8 @@ void renderFlight(const RuntimeModel& model, const RenderOptions& o, int width, 
       for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], double(p[3 * v + a])), hi[a] = std::max(hi[a], double(p[3 * v + a]));
   const Eigen::Vector3d grow = Eigen::Vector3d::Constant(0.1 * (hi - lo).norm());
   TriangleSoup world;
-  for (const std::string& text : o.scenario.colliders)
-    appendCollider(parseCollider(text, o.scenario.friction, o.scenario.restitution), lo, hi, world);
+  for (int k = 0; k < target.colliders().size(); ++k)
+    appendCollider(target.colliders()[k], target.colliders().surface(k), lo, hi, world);
   const Camera cam = Camera::framing(lo - grow, hi + grow, width, height);
   const std::vector<unsigned> triangles = model.triangles();
   for (const auto& p : shots) {

@@ -29,11 +29,11 @@ void RuntimeTarget::startFlight(const SimOptions& o) {
   if (qv_instance_set_rigid_state(instance_.get(), &state) != QV_OK)
     throw std::runtime_error("--position, --velocity and --angular-velocity must be finite");
   for (const std::string& text : o.colliders) {
-    colliders_.push_back(parseCollider(text, o.friction, o.restitution));
-    if (qv_instance_set_colliders(instance_.get(), &colliders_.back(), 1) != QV_OK)
+    colliders_.add(text, o.friction, o.restitution);
+    if (qv_instance_set_colliders(instance_.get(), &colliders_[colliders_.size() - 1], 1) != QV_OK)
       throw std::runtime_error("--collider '" + text + "': sizes must be positive, a plane's normal not zero");
   }
-  if (qv_instance_set_colliders(instance_.get(), colliders_.data(), static_cast<int>(colliders_.size())) != QV_OK)
+  if (qv_instance_set_colliders(instance_.get(), colliders_.data(), colliders_.size()) != QV_OK)
     throw std::runtime_error("--friction and --restitution: mu >= 0, restitution in 0..1");
   contacts_.resize(static_cast<size_t>(instance_.config().max_contacts));
 }

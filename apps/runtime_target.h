@@ -3,6 +3,7 @@
 #include <string>
 
 #include "apps/sim_scenario.h"
+#include "apps/support/collider_set.h"
 #include "apps/support/runtime_model.h"
 
 namespace quiver::app {
@@ -26,13 +27,14 @@ public:
   int heldBackSteps() const { return heldBack_; }
   double energyRemoved() const { return energyRemoved_; }  // J, by the minimising solver's energy budget
   double maxPenetration() const { return maxPenetration_; }  // m, the deepest contact seen
+  const ColliderSet& colliders() const { return colliders_; }
 
 private:
   const RuntimeModel& model_;
   RuntimeInstance instance_;
   int indefinite_ = 0, heldBack_ = 0;
   double energyRemoved_ = 0;
-  std::vector<qv_collider> colliders_;  // the instance reads them by pointer
+  ColliderSet colliders_;  // the instance reads them by pointer
   std::vector<qv_contact> contacts_;
   double maxPenetration_ = 0;
 };

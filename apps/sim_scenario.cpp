@@ -34,7 +34,8 @@ void SimOptions::addScenarioTo(CLI::App& app) {
   app.add_option("--velocity", velocity, "Free flight: initial velocity vx,vy,vz, m/s")->delimiter(',')->expected(3);
   app.add_option("--collider", colliders,
                  "Free flight: a collider, repeatable: plane:nx,ny,nz,d (points with n.x = d), sphere:x,y,z,radius, "
-                 "box:cx,cy,cz,hx,hy,hz (axis-aligned), capsule:x0,y0,z0,x1,y1,z1,radius");
+                 "box:cx,cy,cz,hx,hy,hz (axis-aligned), capsule:x0,y0,z0,x1,y1,z1,radius, mesh:FILE[,x,y,z] (a closed "
+                 "surface: OBJ, STL, PLY, glTF, FBX, ... or a tet mesh's boundary; moved by x,y,z)");
   app.add_option("--friction", friction, "Free flight: Coulomb friction of the colliders")->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_option("--restitution", restitution, "Free flight: restitution of the colliders, 0..1")
       ->capture_default_str()
@@ -86,42 +87,6 @@ bool SimOptions::hasLoad() const {
 double percentile(std::vector<double> values, double p) {
   std::sort(values.begin(), values.end());
   return values.empty() ? 0 : values[std::min(values.size() - 1, static_cast<size_t>(p * (values.size() - 1) + 0.5))];
-}
-
-qv_collider parseCollider(const std::string& text, double friction, double restitution) {
-  static const struct {
-    const char* name;
-    qv_collider_type type;
-    size_t count;
-    const char* form;
-  } kTypes[] = {{"plane", QV_COLLIDER_PLANE, 4, "nx,ny,nz,d"},
-                {"sphere", QV_COLLIDER_SPHERE, 4, "x,y,z,radius"},
-                {"box", QV_COLLIDER_BOX, 6, "cx,cy,cz,hx,hy,hz"},
-                {"capsule", QV_COLLIDER_CAPSULE, 7, "x0,y0,z0,x1,y1,z1,radius"}};
-  const size_t colon = text.find(':');
-  const std::string name = text.substr(0, colon);
-  for (const auto& t : kTypes) {
-    if (name != t.name) continue;
-    const std::string bad = "--collider '" + text + "': expected " + t.name + ":" + t.form;
-    std::vector<double> numbers;
-    std::stringstream in(colon == std::string::npos ? "" : text.substr(colon + 1));
-    for (std::string item; std::getline(in, item, ',');) {
-      size_t used = 0;
-      double x = 0;
-      try {
-        x = std::stod(item, &used);
-      } catch (const std::exception&) {
-        throw std::runtime_error(bad);
-      }
-      if (used != item.size() || !std::isfinite(x)) throw std::runtime_error(bad);
-      numbers.push_back(x);
-    }
-    if (numbers.size() != t.count) throw std::runtime_error(bad);
-    qv_collider c{t.type, {}, friction, restitution};
-    std::copy(numbers.begin(), numbers.end(), c.data);
-    return c;
-  }
-  throw std::runtime_error("--collider '" + text + "': the type is plane, sphere, box or capsule (mesh colliders are not there yet)");
 }
 
 std::vector<int> selectGroup(const TetMesh& mesh, const std::string& selector) {

@@ -28,7 +28,7 @@ struct SimOptions {
   std::vector<double> position{0, 0, 0};         // m, the model translated from where it was baked
   std::vector<double> velocity{0, 0, 0};         // m/s
   std::vector<double> angularVelocity{0, 0, 0};  // rad/s, about the centre of mass
-  std::vector<std::string> colliders;            // --collider TYPE:NUMBERS (parseCollider), free flight only
+  std::vector<std::string> colliders;            // --collider TYPE:NUMBERS (ColliderSet::add), free flight only
   double friction = 0.5;                         // Coulomb mu of every collider
   double restitution = 0.2;                      // of every collider, 0..1
   StepSettings step;                    // integrator, elasticity, time step, Newton iterations per step
@@ -70,10 +70,6 @@ struct ScenarioResult {
   long newtonIterations = 0;
   int failedSteps = 0;  // resets (runtime) — the scenario goes on
 };
-
-// A --collider value: plane:nx,ny,nz,d (points with n.x = d), sphere:x,y,z,radius, box:cx,cy,cz,hx,hy,hz
-// (axis-aligned) or capsule:x0,y0,z0,x1,y1,z1,radius; throws naming the value and what is wrong.
-qv_collider parseCollider(const std::string& text, double friction, double restitution);
 
 // The vertices of `mesh` that the --group `selector` picks; throws naming --group if it is malformed or picks none.
 std::vector<int> selectGroup(const TetMesh& mesh, const std::string& selector);

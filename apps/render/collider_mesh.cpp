@@ -43,9 +43,12 @@ void addRoundShape(TriangleSoup& soup, const Eigen::Vector3d& centre, const Eige
 
 } // namespace
 
-void appendCollider(const qv_collider& c, const Eigen::Vector3d& boxMin, const Eigen::Vector3d& boxMax,
-                    TriangleSoup& soup) {
+void appendCollider(const qv_collider& c, const SurfaceMesh* surface, const Eigen::Vector3d& boxMin,
+                    const Eigen::Vector3d& boxMax, TriangleSoup& soup) {
   const double* d = c.data;
+  const Eigen::Vector3d w(c.rotation[0], c.rotation[1], c.rotation[2]), centre(d[0], d[1], d[2]);
+  const Eigen::Matrix3d turn = w.norm() > 0 ? Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix()
+                                            : Eigen::Matrix3d::Identity();
   switch (c.type) {
     case QV_COLLIDER_PLANE: {
       const Eigen::Vector3d n = Eigen::Vector3d(d[0], d[1], d[2]).normalized();
@@ -65,11 +68,11 @@ void appendCollider(const qv_collider& c, const Eigen::Vector3d& boxMin, const E
       break;
     }
     case QV_COLLIDER_BOX: {
-      const Eigen::Vector3d centre(d[0], d[1], d[2]), half(d[3], d[4], d[5]);
+      const Eigen::Vector3d half(d[3], d[4], d[5]);
       unsigned corner[8];
       for (int k = 0; k < 8; ++k)
-        corner[k] = addVertex(soup, centre + Eigen::Vector3d((k & 1) ? 1 : -1, (k & 2) ? 1 : -1, (k & 4) ? 1 : -1)
-                                                 .cwiseProduct(half));
+        corner[k] = addVertex(soup, centre + turn * Eigen::Vector3d((k & 1) ? 1 : -1, (k & 2) ? 1 : -1, (k & 4) ? 1 : -1)
+                                                        .cwiseProduct(half));
       // Faces, counter-clockwise seen from outside: -x, +x, -y, +y, -z, +z.
       addQuad(soup, corner[0], corner[4], corner[6], corner[2]);
       addQuad(soup, corner[1], corner[3], corner[7], corner[5]);
@@ -77,6 +80,15 @@ void appendCollider(const qv_collider& c, const Eigen::Vector3d& boxMin, const E
       addQuad(soup, corner[2], corner[6], corner[7], corner[3]);
       addQuad(soup, corner[0], corner[2], corner[3], corner[1]);
       addQuad(soup, corner[4], corner[5], corner[7], corner[6]);
+      break;
+    }
+    case QV_COLLIDER_MESH: {
+      if (!surface) break;
+      const unsigned first = static_cast<unsigned>(soup.positions.size() / 3);
+      for (size_t v = 0; v < surface->positions.size() / 3; ++v)
+        addVertex(soup, centre + turn * Eigen::Vector3d(surface->positions[3 * v], surface->positions[3 * v + 1],
+                                                        surface->positions[3 * v + 2]));
+      for (int index : surface->triangles) soup.triangles.push_back(first + static_cast<unsigned>(index));
       break;
     }
   }

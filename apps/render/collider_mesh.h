@@ -1,10 +1,11 @@
 #pragma once
 // Triangles of the runtime's colliders (qv_collider), for pictures of objects in flight: a plane as
-// the square of it under the framed box, spheres, boxes and capsules tessellated.
+// the square of it under the framed box, spheres, boxes and capsules tessellated, meshes as read.
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "formats/mesh/read_surface.h"
 #include "quiver/quiver.h"
 
 namespace quiver::app {
@@ -15,8 +16,8 @@ struct TriangleSoup {
 };
 
 // Appends `collider`'s surface to `soup`; a plane is the square of side 2 x the box's diagonal
-// around the point of the plane nearest the box's centre.
-void appendCollider(const qv_collider& collider, const Eigen::Vector3d& boxMin, const Eigen::Vector3d& boxMax,
-                    TriangleSoup& soup);
+// around the point of the plane nearest the box's centre; a mesh collider is `surface` (its file's) placed.
+void appendCollider(const qv_collider& collider, const SurfaceMesh* surface, const Eigen::Vector3d& boxMin,
+                    const Eigen::Vector3d& boxMax, TriangleSoup& soup);
 
 } // namespace quiver::app

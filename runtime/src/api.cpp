@@ -15,6 +15,8 @@
 #include "integrators/integrator.h"
 #include "model.h"
 #include "output.h"
+#include "triangle_mesh.h"
+#include "world.h"
 #include "quiver/quiver.h"
 
 #define QV_STR2(x) #x
@@ -350,22 +352,23 @@ qv_result qv_instance_set_rigid_state(qv_instance* s, const qv_rigid_state* stat
   return QV_OK;
 }
 
-qv_result qv_instance_set_colliders(qv_instance* s, const qv_collider* colliders, int count) {
-  if (!s || !s->flying() || count < 0 || (count > 0 && !colliders)) return QV_ERROR_INVALID_ARGUMENT;
+namespace {
+
+bool validColliders(const qv_collider* colliders, int count) {
+  if (count < 0 || (count > 0 && !colliders)) return false;
   for (int k = 0; k < count; ++k)
-    if (!quiver::rt::validCollider(colliders[k])) return QV_ERROR_INVALID_ARGUMENT;
-  s->colliders = count ? colliders : nullptr;
-  s->colliderCount = count;
-  return QV_OK;
+    if (!validCollider(colliders[k])) return false;
+  return true;
 }
 
-int qv_instance_contacts(const qv_instance* s, qv_contact* out, int capacity) {
-  if (!s) return 0;
-  for (int j = 0; out && j < std::min(capacity, s->contactCount); ++j) {
-    const quiver::rt::Contact& c = s->contacts[j];
+int copyContacts(const ContactList& list, qv_contact* out, int capacity) {
+  for (int j = 0; out && j < std::min(capacity, list.count); ++j) {
+    const Contact& c = list.contacts[j];
     qv_contact& o = out[j];
     o.vertex = c.vertex;
     o.collider = c.collider;
+    o.instance = c.body;
+    o.other = c.other;
     o.depth = c.deformedDepth;
     for (int a = 0; a < 3; ++a) {
       o.point[a] = c.point[a];
@@ -373,7 +376,77 @@ int qv_instance_contacts(const qv_instance* s, qv_contact* out, int capacity) {
       o.impulse[a] = c.normalImpulse * c.normal[a] + c.tangentImpulse[0] * c.tangent[0][a] + c.tangentImpulse[1] * c.tangent[1][a];
     }
   }
-  return s->contactCount;
+  return list.count;
+}
+
+} // namespace
+
+qv_result qv_instance_set_colliders(qv_instance* s, const qv_collider* colliders, int count) {
+  if (!s || !s->flying() || !validColliders(colliders, count)) return QV_ERROR_INVALID_ARGUMENT;
+  s->colliders = count ? colliders : nullptr;
+  s->colliderCount = count;
+  return QV_OK;
+}
+
+int qv_instance_contacts(const qv_instance* s, qv_contact* out, int capacity) {
+  if (!s) return 0;
+  return copyContacts(ContactList{s->contacts, s->contactCount, s->config.max_contacts}, out, capacity);
+}
+
+qv_result qv_triangle_mesh_create(const double* positions, int vertex_count, const int* triangles, int triangle_count,
+                                  const qv_allocator* allocator, qv_triangle_mesh** mesh, char* message, size_t message_size) {
+  if (!mesh) return QV_ERROR_INVALID_ARGUMENT;
+  *mesh = nullptr;
+  if (!positions || !triangles || vertex_count < 0 || triangle_count < 0) return QV_ERROR_INVALID_ARGUMENT;
+  return createTriangleMesh(positions, vertex_count, triangles, triangle_count, allocatorOr(allocator), mesh, message,
+                            message_size);
+}
+
+void qv_triangle_mesh_destroy(qv_triangle_mesh* mesh) {
+  if (mesh) destroyTriangleMesh(mesh);
+}
+
+void qv_world_config_init(qv_world_config* config) {
+  if (config) defaultWorldConfig(*config);
+}
+
+qv_result qv_world_create(const qv_world_config* config, const qv_allocator* allocator, qv_world** world) {
+  if (!world) return QV_ERROR_INVALID_ARGUMENT;
+  *world = nullptr;
+  qv_world_config settings;
+  defaultWorldConfig(settings);
+  if (config) settings = *config;
+  if (!validWorldConfig(settings)) return QV_ERROR_INVALID_ARGUMENT;
+  *world = createWorld(settings, allocatorOr(allocator));
+  return *world ? QV_OK : QV_ERROR_OUT_OF_MEMORY;
+}
+
+void qv_world_destroy(qv_world* world) {
+  if (world) destroyWorld(world);
+}
+
+qv_result qv_world_add(qv_world* world, qv_instance* instance, int* index) {
+  if (!world || !instance || !instance->flying() || world->count == world->config.max_instances)
+    return QV_ERROR_INVALID_ARGUMENT;
+  for (int i = 0; i < world->count; ++i)
+    if (world->instances[i] == instance || world->instances[i]->config.time_step != instance->config.time_step)
+      return QV_ERROR_INVALID_ARGUMENT;
+  if (index) *index = world->count;
+  world->instances[world->count++] = instance;
+  return QV_OK;
+}
+
+qv_result qv_world_set_colliders(qv_world* world, const qv_collider* colliders, int count) {
+  if (!world || !validColliders(colliders, count)) return QV_ERROR_INVALID_ARGUMENT;
+  world->colliders = count ? colliders : nullptr;
+  world->colliderCount = count;
+  return QV_OK;
+}
+
+int qv_world_step(qv_world* world) { return world ? world->step() : 0; }
+
+int qv_world_contacts(const qv_world* world, qv_contact* contacts, int capacity) {
+  return world ? copyContacts(world->contacts, contacts, capacity) : 0;
 }
 
 double qv_instance_stable_time_step(const qv_instance* s) { return s ? s->model->stableStep : 0; }

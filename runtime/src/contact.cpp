@@ -1,14 +1,19 @@
 #include "contact.h"
 
 #include <cmath>
+#include <cstring>
+
+#include "triangle_mesh.h"
 
 namespace quiver::rt {
 
 namespace {
 
 constexpr double kSoftness = 0.1;
+constexpr int kSweeps = 24;
 
 double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+double norm3(const double a[3]) { return std::sqrt(dot3(a, a)); }
 
 void cross3(const double a[3], const double b[3], double out[3]) {
   out[0] = a[1] * b[2] - a[2] * b[1];
@@ -22,43 +27,228 @@ bool finiteAll(const double* v, int n) {
   return true;
 }
 
-// Distance from p to c along d (|d| > 0), normal d / |d|; `fallback` where p is at c.
+// Distance from p to c along d (|d| > 0), normal d / |d|; +z where p is at c.
 double away(const double p[3], const double c[3], double normal[3]) {
   const double d[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
-  const double len = std::sqrt(dot3(d, d));
+  const double len = norm3(d);
   for (int a = 0; a < 3; ++a) normal[a] = len > 0 ? d[a] / len : (a == 2 ? 1.0 : 0.0);
   return len;
 }
 
-// 1 / (1/m + n . ((I^-1 (a x n)) x a)): the mass the impulse along n at arm a meets.
-double effectiveMass(const RigidFrame& f, double mass, const double a[3], const double n[3]) {
+// A collider's turn (Rodrigues' formula on its rotation vector), row-major; false when it has none.
+bool colliderRotation(const qv_collider& c, double R[9]) {
+  const double* w = c.rotation;
+  const double angle = norm3(w);
+  if (!(angle > 0)) return false;
+  const double k[3] = {w[0] / angle, w[1] / angle, w[2] / angle}, s = std::sin(angle), v = 1 - std::cos(angle);
+  R[0] = 1 + v * (k[0] * k[0] - 1), R[1] = v * k[0] * k[1] - s * k[2], R[2] = v * k[0] * k[2] + s * k[1];
+  R[3] = v * k[0] * k[1] + s * k[2], R[4] = 1 + v * (k[1] * k[1] - 1), R[5] = v * k[1] * k[2] - s * k[0];
+  R[6] = v * k[0] * k[2] - s * k[1], R[7] = v * k[1] * k[2] + s * k[0], R[8] = 1 + v * (k[2] * k[2] - 1);
+  return true;
+}
+
+// Where the collider's angular velocity turns it about (qv_collider's `velocity`).
+void referencePoint(const qv_collider& c, double out[3]) {
+  const double* d = c.data;
+  if (c.type == QV_COLLIDER_PLANE) {
+    const double s = d[3] / dot3(d, d);
+    for (int a = 0; a < 3; ++a) out[a] = s * d[a];
+  } else {
+    for (int a = 0; a < 3; ++a) out[a] = d[a];
+  }
+}
+
+// The velocity of a kinematic collider's surface at p.
+void surfaceVelocity(const qv_collider& c, const double p[3], double out[3]) {
+  double ref[3], rel[3], turn[3];
+  referencePoint(c, ref);
+  for (int a = 0; a < 3; ++a) rel[a] = p[a] - ref[a];
+  cross3(c.angular_velocity, rel, turn);
+  for (int a = 0; a < 3; ++a) out[a] = c.velocity[a] + turn[a];
+}
+
+// Axis-aligned box centred at the origin with half extents e: distance of p and the outward normal.
+double boxDistance(const double p[3], const double e[3], double normal[3]) {
+  double q[3], outside = 0, inside = -INFINITY;
+  int deepest = 0;
+  for (int a = 0; a < 3; ++a) {
+    q[a] = std::fabs(p[a]) - e[a];
+    outside += q[a] > 0 ? q[a] * q[a] : 0;
+    if (q[a] > inside) inside = q[a], deepest = a;
+  }
+  if (outside > 0) {
+    const double distance = std::sqrt(outside);
+    for (int a = 0; a < 3; ++a) normal[a] = (q[a] > 0 ? q[a] : 0) * (p[a] >= 0 ? 1 : -1) / distance;
+    return distance;
+  }
+  for (int a = 0; a < 3; ++a) normal[a] = a == deepest ? (p[a] >= 0 ? 1 : -1) : 0;
+  return inside;
+}
+
+// 1 / (1/m + n . ((I^-1 (a x n)) x a)): the mass the impulse along n at arm a meets on one body.
+double inverseMass(const ContactBody& b, const double a[3], const double n[3]) {
   double an[3], ian[3], back[3];
   cross3(a, n, an);
-  f.inverseInertia(an, ian);
+  b.instance->frame.inverseInertia(an, ian);
   cross3(ian, a, back);
-  return 1.0 / (1.0 / mass + dot3(n, back));
+  return 1.0 / b.instance->model->info.total_mass + dot3(n, back);
+}
+
+// The frame's velocity at a point with arm a, omega from the solve's current angular momentum.
+void bodyPointVelocity(const ContactBody& b, const double a[3], double out[3]) {
+  const RigidFrame& f = b.instance->frame;
+  double w[3], wa[3], dw[3];
+  const double dL[3] = {b.angularMomentum[0] - f.angularMomentum[0], b.angularMomentum[1] - f.angularMomentum[1],
+                        b.angularMomentum[2] - f.angularMomentum[2]};
+  f.inverseInertia(dL, dw);
+  for (int k = 0; k < 3; ++k) w[k] = b.omega[k] + dw[k];
+  cross3(w, a, wa);
+  for (int k = 0; k < 3; ++k) out[k] = b.velocity[k] + wa[k];
+}
+
+void applyImpulse(ContactBody& b, const double a[3], const double J[3], double sign) {
+  double aj[3];
+  cross3(a, J, aj);
+  const double mass = b.instance->model->info.total_mass;
+  for (int k = 0; k < 3; ++k) {
+    b.velocity[k] += sign * J[k] / mass;
+    b.angularMomentum[k] += sign * aj[k];
+  }
+}
+
+// Vertex v of a body's rest shape, carried by its frame (or deformed by q when `deformed`).
+void worldVertex(const qv_instance& s, int v, bool deformed, double out[3]) {
+  const qv_model& m = *s.model;
+  double body[3], u[3] = {};
+  if (deformed) m.vertexLinear(v, s.q, u, nullptr);
+  for (int a = 0; a < 3; ++a) body[a] = m.rest[3 * v + a] - m.rigidBody[a] + u[a];
+  s.frame.toWorld(body, out);
+}
+
+// Signed distance of world point p to a body's rest surface carried by its frame; the surface
+// vertex nearest the closest point through `vertex`. False when beyond `reach`.
+bool bodyDistance(const qv_instance& s, const double p[3], double reach, double& distance, double normal[3], int* vertex) {
+  const qv_model& m = *s.model;
+  double rel[3], local[3], n[3];
+  for (int a = 0; a < 3; ++a) rel[a] = p[a] - s.frame.position[a];
+  s.frame.toBody(rel, local);
+  for (int a = 0; a < 3; ++a) local[a] += m.rigidBody[a];  // the mesh is in the model's rest coordinates
+  int triangle = 0;
+  if (!m.surfaceMesh->distance(local, reach, distance, n, &triangle)) return false;
+  s.frame.toWorldDirection(n, normal);
+  if (vertex) {
+    double best = INFINITY;
+    for (int k = 0; k < 3; ++k) {
+      const int v = m.surfaceMesh->triangles[3 * triangle + k];
+      double d2 = 0;
+      for (int a = 0; a < 3; ++a) d2 += (m.rest[3 * v + a] - local[a]) * (m.rest[3 * v + a] - local[a]);
+      if (d2 < best) best = d2, *vertex = v;
+    }
+  }
+  return true;
+}
+
+// Keeps `c` when there is room, or in place of the shallowest contact when it is deeper.
+Contact* admit(ContactList& list, double depth) {
+  if (list.count < list.capacity) return &list.contacts[list.count++];
+  if (!list.capacity) return nullptr;
+  int slot = 0;
+  for (int j = 1; j < list.count; ++j)
+    if (list.contacts[j].depth > list.contacts[slot].depth) slot = j;
+  return list.contacts[slot].depth > depth ? &list.contacts[slot] : nullptr;
+}
+
+double bodySpeed(const ContactBody& b) { return norm3(b.velocity) + norm3(b.omega) * b.instance->surfaceRadius; }
+
+// Each surface vertex of body i against every collider.
+void findColliderContacts(const ContactBody* bodies, int i, const qv_collider* colliders, int count, double h,
+                          ContactList& list) {
+  const qv_instance& s = *bodies[i].instance;
+  const double speed = bodySpeed(bodies[i]);
+  for (int k = 0; k < count; ++k) {
+    const qv_collider& col = colliders[k];
+    for (int n = 0; n < s.surfaceCount; ++n) {
+      const int v = s.surfaceVertices[n];
+      double p[3], u[3], depth, normal[3];
+      worldVertex(s, v, false, p);
+      surfaceVelocity(col, p, u);
+      const double margin = s.contactSlop + 2 * h * (speed + norm3(u));
+      if (!colliderDistance(col, p, margin, depth, normal) || depth > margin) continue;
+      Contact* ct = admit(list, depth);
+      if (!ct) continue;
+      *ct = Contact{};
+      ct->body = i, ct->vertex = v, ct->collider = k, ct->depth = depth;
+      ct->friction = col.friction, ct->restitution = col.restitution;
+      double deformed[3], ignored[3];
+      worldVertex(s, v, true, deformed);
+      colliderDistance(col, deformed, INFINITY, ct->deformedDepth, ignored);
+      for (int a = 0; a < 3; ++a) {
+        ct->point[a] = p[a], ct->normal[a] = normal[a], ct->surfaceVelocity[a] = u[a];
+        ct->arm[a] = p[a] - s.frame.position[a];
+      }
+    }
+  }
+}
+
+// Each surface vertex of body i against body j's rest surface, when their spheres come within reach.
+void findBodyContacts(const ContactBody* bodies, int i, int j, double h, const ContactMaterial& material,
+                      ContactList& list) {
+  const qv_instance &a = *bodies[i].instance, &b = *bodies[j].instance;
+  if (!b.model->surfaceMesh) return;
+  const double margin = std::fmax(a.contactSlop, b.contactSlop) + 2 * h * (bodySpeed(bodies[i]) + bodySpeed(bodies[j]));
+  double gap[3];
+  for (int k = 0; k < 3; ++k) gap[k] = a.frame.position[k] - b.frame.position[k];
+  if (norm3(gap) > a.surfaceRadius + b.surfaceRadius + margin) return;
+  for (int n = 0; n < a.surfaceCount; ++n) {
+    const int v = a.surfaceVertices[n];
+    double p[3], depth, normal[3];
+    int otherVertex = 0;
+    worldVertex(a, v, false, p);
+    if (!bodyDistance(b, p, margin, depth, normal, &otherVertex) || depth > margin) continue;
+    Contact* ct = admit(list, depth);
+    if (!ct) continue;
+    *ct = Contact{};
+    ct->body = i, ct->other = j, ct->vertex = v, ct->otherVertex = otherVertex, ct->depth = depth;
+    ct->friction = material.friction, ct->restitution = material.restitution;
+    double deformed[3], ignored[3];
+    worldVertex(a, v, true, deformed);
+    if (!bodyDistance(b, deformed, INFINITY, ct->deformedDepth, ignored, nullptr)) ct->deformedDepth = depth;
+    for (int k = 0; k < 3; ++k) {
+      ct->point[k] = p[k], ct->normal[k] = normal[k];
+      ct->arm[k] = p[k] - a.frame.position[k];
+      ct->otherArm[k] = p[k] - b.frame.position[k];
+    }
+  }
 }
 
 } // namespace
 
 bool validCollider(const qv_collider& c) {
-  if (!finiteAll(c.data, 8) || !(c.friction >= 0) || !std::isfinite(c.friction) || !(c.restitution >= 0) ||
-      !(c.restitution <= 1))
+  if (!finiteAll(c.data, 8) || !finiteAll(c.rotation, 3) || !finiteAll(c.velocity, 3) ||
+      !finiteAll(c.angular_velocity, 3) || !(c.friction >= 0) || !std::isfinite(c.friction) ||
+      !(c.restitution >= 0) || !(c.restitution <= 1))
     return false;
   switch (c.type) {
     case QV_COLLIDER_PLANE: return dot3(c.data, c.data) > 0;
     case QV_COLLIDER_SPHERE: return c.data[3] > 0;
     case QV_COLLIDER_BOX: return c.data[3] > 0 && c.data[4] > 0 && c.data[5] > 0;
     case QV_COLLIDER_CAPSULE: return c.data[6] > 0;
+    case QV_COLLIDER_MESH: return c.mesh != nullptr;
     default: return false;
   }
 }
 
-bool colliderDistance(const qv_collider& c, const double p[3], double& distance, double normal[3]) {
+bool colliderDistance(const qv_collider& c, const double p[3], double reach, double& distance, double normal[3]) {
   const double* d = c.data;
+  double R[9], local[3], localNormal[3];
+  const bool turned = (c.type == QV_COLLIDER_BOX || c.type == QV_COLLIDER_MESH) && colliderRotation(c, R);
+  if (c.type == QV_COLLIDER_BOX || c.type == QV_COLLIDER_MESH) {  // into the collider's own frame: R^T (p - centre)
+    const double rel[3] = {p[0] - d[0], p[1] - d[1], p[2] - d[2]};
+    for (int a = 0; a < 3; ++a) local[a] = turned ? R[a] * rel[0] + R[3 + a] * rel[1] + R[6 + a] * rel[2] : rel[a];
+  }
   switch (c.type) {
     case QV_COLLIDER_PLANE: {  // points with n . x = d
-      const double len = std::sqrt(dot3(d, d));
+      const double len = norm3(d);
       for (int a = 0; a < 3; ++a) normal[a] = d[a] / len;
       distance = (dot3(d, p) - d[3]) / len;
       return true;
@@ -66,23 +256,6 @@ bool colliderDistance(const qv_collider& c, const double p[3], double& distance,
     case QV_COLLIDER_SPHERE:
       distance = away(p, d, normal) - d[3];
       return true;
-    case QV_COLLIDER_BOX: {  // axis-aligned: centre d[0..2], half extents d[3..5]
-      double q[3], outside = 0, inside = -INFINITY;
-      int deepest = 0;
-      for (int a = 0; a < 3; ++a) {
-        q[a] = std::fabs(p[a] - d[a]) - d[3 + a];
-        outside += q[a] > 0 ? q[a] * q[a] : 0;
-        if (q[a] > inside) inside = q[a], deepest = a;
-      }
-      if (outside > 0) {
-        distance = std::sqrt(outside);
-        for (int a = 0; a < 3; ++a) normal[a] = (q[a] > 0 ? q[a] : 0) * (p[a] >= d[a] ? 1 : -1) / distance;
-      } else {
-        distance = inside;
-        for (int a = 0; a < 3; ++a) normal[a] = a == deepest ? (p[a] >= d[a] ? 1 : -1) : 0;
-      }
-      return true;
-    }
     case QV_COLLIDER_CAPSULE: {  // segment d[0..2] - d[3..5], radius d[6]
       const double axis[3] = {d[3] - d[0], d[4] - d[1], d[5] - d[2]}, rel[3] = {p[0] - d[0], p[1] - d[1], p[2] - d[2]};
       const double len2 = dot3(axis, axis);
@@ -91,159 +264,138 @@ bool colliderDistance(const qv_collider& c, const double p[3], double& distance,
       distance = away(p, closest, normal) - d[6];
       return true;
     }
+    case QV_COLLIDER_BOX:
+      distance = boxDistance(local, d + 3, localNormal);
+      break;
+    case QV_COLLIDER_MESH:
+      if (!c.mesh || !c.mesh->distance(local, reach, distance, localNormal)) return false;
+      break;
     default: return false;
   }
+  for (int a = 0; a < 3; ++a)
+    normal[a] = turned ? R[3 * a] * localNormal[0] + R[3 * a + 1] * localNormal[1] + R[3 * a + 2] * localNormal[2] : localNormal[a];
+  return true;
 }
 
-void solveContacts(qv_instance& s, double h) {
-  s.contactCount = 0;
-  if (!s.colliderCount) return;
-  RigidFrame& f = s.frame;
-  const qv_model& m = *s.model;
-  const double mass = m.info.total_mass;
-  const double* c = m.rigidBody;
-  double omega[3];
-  f.worldOmega(omega);
-  // How fast the frame can carry a vertex: its reach within the step, plus the slop.
-  const double speed = std::sqrt(dot3(f.velocity, f.velocity)) + std::sqrt(dot3(omega, omega)) * s.surfaceRadius;
-  const double slop = s.contactSlop, margin = slop + 2 * h * speed;
-  const double g = std::sqrt(dot3(f.gravity, f.gravity));
-  const double bounceSpeed = 2 * g * h + 1e-3;  // slower approaches rest instead of bouncing
-
-  // Contacts: each surface vertex of the rest shape carried by the frame against each collider, the
-  // deepest kept when there are too many. Found and solved on the rigid shape: the deformation takes
-  // the forces but does not move the contacts (taking its vertices made the loads on q and the
-  // contacts chase each other: a resting bar fluttered, bent 1.5 cm, its contacts hopping between
-  // its ends and its middle every few steps).
-  for (int i = 0; i < s.surfaceCount; ++i) {
-    const int v = s.surfaceVertices[i];
-    double body[3], p[3];
-    for (int a = 0; a < 3; ++a) body[a] = m.rest[3 * v + a] - c[a];
-    f.toWorld(body, p);
-    for (int k = 0; k < s.colliderCount; ++k) {
-      double depth, normal[3];
-      if (!colliderDistance(s.colliders[k], p, depth, normal) || depth > margin) continue;
-      int slot = s.contactCount;
-      if (s.contactCount == s.config.max_contacts) {  // full: replace the shallowest if this is deeper
-        slot = 0;
-        for (int j = 1; j < s.contactCount; ++j)
-          if (s.contacts[j].depth > s.contacts[slot].depth) slot = j;
-        if (s.contacts[slot].depth <= depth) continue;
-      } else {
-        ++s.contactCount;
-      }
-      Contact& ct = s.contacts[slot];
-      ct = Contact{};
-      ct.vertex = v;
-      ct.collider = k;
-      ct.depth = depth;
-      // What the caller sees: the deformed vertex's own distance (the deformation adds to the frame's).
-      double u[3], deformed[3], world[3], n[3];
-      m.vertexLinear(v, s.q, u, nullptr);
-      for (int a = 0; a < 3; ++a) deformed[a] = body[a] + u[a];
-      f.toWorld(deformed, world);
-      colliderDistance(s.colliders[k], world, ct.deformedDepth, n);
-      for (int a = 0; a < 3; ++a) {
-        ct.point[a] = p[a];
-        ct.normal[a] = normal[a];
-        ct.arm[a] = p[a] - f.position[a];
-      }
-    }
+void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* colliders, int colliderCount,
+                   const ContactMaterial& material, ContactList& list, double h) {
+  list.count = 0;
+  for (int i = 0; i < bodyCount; ++i) {
+    ContactBody& b = bodies[i];
+    const RigidFrame& f = b.instance->frame;
+    std::memcpy(b.velocity, f.velocity, sizeof b.velocity);
+    std::memcpy(b.angularMomentum, f.angularMomentum, sizeof b.angularMomentum);
+    f.worldOmega(b.omega);
   }
-  if (!s.contactCount) return;
+  // Contacts: each surface vertex of the rest shape carried by the frame. Found and solved on the
+  // rigid shape: the deformation takes the forces but does not move the contacts (taking its
+  // vertices made the loads on q and the contacts chase each other: a resting bar fluttered, bent
+  // 1.5 cm, its contacts hopping between its ends and its middle every few steps).
+  for (int i = 0; i < bodyCount; ++i) {
+    findColliderContacts(bodies, i, colliders, colliderCount, h, list);
+    for (int j = 0; j < bodyCount; ++j)
+      if (j != i) findBodyContacts(bodies, i, j, h, material, list);
+  }
+  if (!list.count) return;
 
-  // Velocities: the frame's, and each contact point's including the deformation's own.
-  double v[3] = {f.velocity[0], f.velocity[1], f.velocity[2]};
-  double L[3] = {f.angularMomentum[0], f.angularMomentum[1], f.angularMomentum[2]};
-  // The frame's velocity at a contact: v + omega x arm, omega from the current L. (The deformation's
-  // own velocity is left out: the frame's impulses cannot change it, and chasing it pumps energy.)
-  const auto pointVelocity = [&](const Contact& ct, double out[3]) {
-    double w[3], wa[3], dw[3];
-    const double dL[3] = {L[0] - f.angularMomentum[0], L[1] - f.angularMomentum[1], L[2] - f.angularMomentum[2]};
-    f.inverseInertia(dL, dw);
-    for (int a = 0; a < 3; ++a) w[a] = omega[a] + dw[a];
-    cross3(w, ct.arm, wa);
-    for (int a = 0; a < 3; ++a) out[a] = v[a] + wa[a];
+  // The relative velocity at a contact: body's frame less the other's (or the collider's surface).
+  const auto relativeVelocity = [&](const Contact& ct, double out[3]) {
+    bodyPointVelocity(bodies[ct.body], ct.arm, out);
+    double other[3];
+    if (ct.other >= 0) {
+      bodyPointVelocity(bodies[ct.other], ct.otherArm, other);
+    } else {
+      std::memcpy(other, ct.surfaceVelocity, sizeof other);
+    }
+    for (int a = 0; a < 3; ++a) out[a] -= other[a];
   };
-  for (int j = 0; j < s.contactCount; ++j) {
-    Contact& ct = s.contacts[j];
-    const qv_collider& col = s.colliders[ct.collider];
+  const auto effectiveMass = [&](const Contact& ct, const double n[3]) {
+    return 1.0 / (inverseMass(bodies[ct.body], ct.arm, n) + (ct.other >= 0 ? inverseMass(bodies[ct.other], ct.otherArm, n) : 0.0));
+  };
+  const auto apply = [&](const Contact& ct, const double J[3]) {
+    applyImpulse(bodies[ct.body], ct.arm, J, 1);
+    if (ct.other >= 0) applyImpulse(bodies[ct.other], ct.otherArm, J, -1);
+  };
+  for (int j = 0; j < list.count; ++j) {
+    Contact& ct = list.contacts[j];
+    const qv_instance& s = *bodies[ct.body].instance;
+    const double slop = s.contactSlop;
+    // Slower approaches than the step's gravity gives rest instead of bouncing.
+    const double bounceSpeed = 2 * norm3(s.frame.gravity) * h + 1e-3;
     double vel[3];
-    pointVelocity(ct, vel);
+    relativeVelocity(ct, vel);
     const double vn = dot3(vel, ct.normal);
     // Approach until the surfaces meet, no further; push out what penetrates beyond the slop.
     ct.target = ct.depth > slop ? -ct.depth / h : 0.2 * (-ct.depth - slop) / h;
-    ct.bounce = vn < -bounceSpeed ? -col.restitution * vn : 0.0;
-    ct.normalMass = effectiveMass(f, mass, ct.arm, ct.normal);
+    ct.bounce = vn < -bounceSpeed ? -ct.restitution * vn : 0.0;
+    ct.normalMass = effectiveMass(ct, ct.normal);
     // Tangents: the sliding direction first (any, when not sliding).
     double t0[3] = {vel[0] - vn * ct.normal[0], vel[1] - vn * ct.normal[1], vel[2] - vn * ct.normal[2]};
-    double len = std::sqrt(dot3(t0, t0));
+    double len = norm3(t0);
     if (len < 1e-12) {
       const double helper[3] = {std::fabs(ct.normal[0]) < 0.9 ? 1.0 : 0.0, std::fabs(ct.normal[0]) < 0.9 ? 0.0 : 1.0, 0};
       cross3(ct.normal, helper, t0);
-      len = std::sqrt(dot3(t0, t0));
+      len = norm3(t0);
     }
     for (int a = 0; a < 3; ++a) ct.tangent[0][a] = t0[a] / len;
     cross3(ct.normal, ct.tangent[0], ct.tangent[1]);
-    for (int t = 0; t < 2; ++t) ct.tangentMass[t] = effectiveMass(f, mass, ct.arm, ct.tangent[t]);
+    for (int t = 0; t < 2; ++t) ct.tangentMass[t] = effectiveMass(ct, ct.tangent[t]);
   }
-  const auto apply = [&](const Contact& ct, const double impulse[3]) {
-    double aj[3];
-    cross3(ct.arm, impulse, aj);
-    for (int a = 0; a < 3; ++a) {
-      v[a] += impulse[a] / mass;
-      L[a] += aj[a];
-    }
-  };
-  for (int iteration = 0; iteration < 24; ++iteration)
-    for (int j = 0; j < s.contactCount; ++j) {
-      Contact& ct = s.contacts[j];
-      // Restitution once the contact holds: the last iterations aim at the bounce, as fast away as the
+  for (int sweep = 0; sweep < kSweeps; ++sweep)
+    for (int j = 0; j < list.count; ++j) {
+      Contact& ct = list.contacts[j];
+      // Restitution once the contact holds: the last sweeps aim at the bounce, as fast away as the
       // approach was times the restitution, where the impulse pushes (speculative contacts would
       // otherwise stop the approach a step early and never bounce).
-      if (iteration == 12) {
+      if (sweep == kSweeps / 2) {
         ct.stopImpulse = ct.normalImpulse;
         if (ct.normalImpulse > 0 && ct.bounce > 0) ct.target = std::fmax(ct.target, ct.bounce);
       }
       double vel[3];
-      pointVelocity(ct, vel);
-      // Normal: accumulated impulse >= 0.
+      relativeVelocity(ct, vel);
+      // Normal: accumulated impulse >= 0. Slightly soft (compliance kSoftness / normalMass): a
+      // resting face shares its weight among its contacts by how deep each is, rather than as the
+      // sweep order happens to (which dents a soft object under a few loaded vertices).
       const double before = ct.normalImpulse;
-      // Slightly soft (compliance kSoftness / normalMass): a resting face shares its weight among its
-      // contacts by how deep each is, rather than as the iteration order happens to (which dents a
-      // soft object under a few loaded vertices).
       ct.normalImpulse = std::fmax(0.0, before + (ct.target - dot3(vel, ct.normal) - kSoftness * before / ct.normalMass) /
                                                  ((1 + kSoftness) / ct.normalMass));
       double J[3];
       for (int a = 0; a < 3; ++a) J[a] = (ct.normalImpulse - before) * ct.normal[a];
       apply(ct, J);
       // Friction: the accumulated tangent impulse within the disc of radius mu * normal impulse.
-      pointVelocity(ct, vel);
-      const double mu = s.colliders[ct.collider].friction, limit = mu * ct.normalImpulse;
-      double old[2] = {ct.tangentImpulse[0], ct.tangentImpulse[1]}, next[2];
+      relativeVelocity(ct, vel);
+      const double limit = ct.friction * ct.normalImpulse;
+      const double old[2] = {ct.tangentImpulse[0], ct.tangentImpulse[1]};
+      double next[2];
       for (int t = 0; t < 2; ++t) next[t] = old[t] - ct.tangentMass[t] * dot3(vel, ct.tangent[t]);
       const double size = std::sqrt(next[0] * next[0] + next[1] * next[1]);
       if (size > limit) next[0] *= limit / size, next[1] *= limit / size;
-      for (int a = 0; a < 3; ++a)
-        J[a] = (next[0] - old[0]) * ct.tangent[0][a] + (next[1] - old[1]) * ct.tangent[1][a];
+      for (int a = 0; a < 3; ++a) J[a] = (next[0] - old[0]) * ct.tangent[0][a] + (next[1] - old[1]) * ct.tangent[1][a];
       ct.tangentImpulse[0] = next[0], ct.tangentImpulse[1] = next[1];
       apply(ct, J);
     }
-  for (int a = 0; a < 3; ++a) {
-    f.velocity[a] = v[a];
-    f.angularMomentum[a] = L[a];
+  for (int i = 0; i < bodyCount; ++i) {
+    RigidFrame& f = bodies[i].instance->frame;
+    std::memcpy(f.velocity, bodies[i].velocity, sizeof f.velocity);
+    std::memcpy(f.angularMomentum, bodies[i].angularMomentum, sizeof f.angularMomentum);
   }
-  // The same impulses over the step load the deformation where they act, less the bounce: the
-  // restitution already returns that energy to the frame, and loading q with it too would make energy.
-  for (int j = 0; j < s.contactCount; ++j) {
-    const Contact& ct = s.contacts[j];
+  // The same impulses over the step load the deformations where they act, less the bounce: the
+  // restitution already returns that energy to the frames, and loading q with it too would make energy.
+  for (int j = 0; j < list.count; ++j) {
+    const Contact& ct = list.contacts[j];
     const double normal = ct.bounce > 0 ? std::fmin(ct.normalImpulse, ct.stopImpulse) : ct.normalImpulse;
-    double world[3], body[3];
+    double world[3];
     for (int a = 0; a < 3; ++a)
-      world[a] = (normal * ct.normal[a] + ct.tangentImpulse[0] * ct.tangent[0][a] +
-                  ct.tangentImpulse[1] * ct.tangent[1][a]) / h;
-    f.toBody(world, body);
-    s.loads.addVertexForce(m, s.config.elasticity, s.q, ct.vertex, body);
+      world[a] = (normal * ct.normal[a] + ct.tangentImpulse[0] * ct.tangent[0][a] + ct.tangentImpulse[1] * ct.tangent[1][a]) / h;
+    const auto load = [&](int body, int vertex, double sign) {
+      qv_instance& s = *bodies[body].instance;
+      double force[3], local[3];
+      for (int a = 0; a < 3; ++a) force[a] = sign * world[a];
+      s.frame.toBody(force, local);
+      s.loads.addVertexForce(*s.model, s.config.elasticity, s.q, vertex, local);
+    };
+    load(ct.body, ct.vertex, 1);
+    if (ct.other >= 0) load(ct.other, ct.otherVertex, -1);
   }
 }
 

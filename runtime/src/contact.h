@@ -1,48 +1,79 @@
 #pragma once
-// Contact of a flying instance with the world's colliders (qv_collider: plane, sphere, box,
-// capsule; the caller's array, which it may move between steps). The object's surface vertices
-// are its contact points.
+// Contact of flying instances with the world's colliders (qv_collider: plane, sphere, box, capsule,
+// triangle mesh; the caller's array, which it may move between steps) and with each other. An
+// object's surface vertices are its contact points; another object is its rest surface carried by
+// its frame (the model's surface mesh, triangle_mesh.h).
 //
-// Each step, between the frame's velocity update and its move (rigid_frame.h):
-// - every surface vertex within reach of a collider (its signed distance below what the frame's
-//   motion can cover in the step, a speculative margin) is a contact, up to max_contacts (the
-//   deepest kept);
-// - sequential impulses (24 sweeps) on the frame's velocity and angular momentum: a normal impulse
+// Each step, between the frames' velocity updates and their moves (rigid_frame.h):
+// - every surface vertex within reach of a collider or another object (its signed distance below
+//   what the two can cover relative to each other in the step, a speculative margin) is a contact,
+//   up to a capacity (the deepest kept);
+// - sequential impulses (24 sweeps) on the frames' velocities and angular momenta: a normal impulse
 //   >= 0 that stops the approach where the surfaces meet (so nothing tunnels while it is seen) and
 //   pushes out what penetrates beyond a slop, slightly soft so that a resting face shares its weight
 //   by depth; from the middle sweep on, contacts that push aim at the bounce (restitution x the
 //   approach speed, when faster than the step's gravity gives); a tangent impulse within the Coulomb
 //   disc mu * normal. Velocity-level constraints: stiff contact at any time step, no penalty
-//   stiffness to tune. The frame's velocity alone (not the deformation's) enters: impulses on the
-//   frame cannot change the deformation's, and chasing it pumped energy;
+//   stiffness to tune. The frames' velocities alone (not the deformation's) enter: impulses on the
+//   frame cannot change the deformation's, and chasing it pumped energy; a kinematic collider's
+//   surface velocity does;
 // - the same impulses, over the step, act on q as vertex forces (so the object squashes where it
 //   lands and sags where it rests), a bounded load for the implicit step; less the bounce, which the
-//   restitution already gives back to the frame (loading q with it too made a bounce gain 31%).
+//   restitution already returns to the frame (loading q with it too made a bounce gain 31%). The
+//   object touched takes the opposite force at its surface vertex nearest the contact.
 #include "instance.h"
 
 namespace quiver::rt {
 
 struct Contact {
-  int vertex = 0, collider = 0;
-  double point[3] = {}, normal[3] = {};
-  double arm[3] = {};        // point - x
+  int body = 0;              // whose vertex
+  int other = -1;            // the body it touches, or -1 for a collider
+  int vertex = 0;            // body's vertex
+  int otherVertex = 0;       // other's surface vertex nearest the contact, which takes the reaction
+  int collider = -1;
+  double point[3] = {}, normal[3] = {};  // normal: out of the collider or the other body
+  double arm[3] = {}, otherArm[3] = {};  // point - x of body and of other
+  double surfaceVelocity[3] = {};        // a kinematic collider's at the point
   double depth = 0;          // signed distance of the rigid shape's vertex (negative: penetrating)
   double deformedDepth = 0;  // of the deformed vertex, reported
-  double target = 0;         // the normal velocity the impulse aims at
+  double target = 0;         // the relative normal velocity the impulse aims at
   double bounce = 0;         // restitution x the approach speed: the target once the contact holds
-  double normalImpulse = 0;  // accumulated, N s
+  double normalImpulse = 0;  // accumulated, N s, on body (other takes its opposite)
   double stopImpulse = 0;    // what it was before the bounce: the part that stops the approach
   double tangentImpulse[2] = {};
   double tangent[2][3] = {};
   double normalMass = 0, tangentMass[2] = {};
+  double friction = 0, restitution = 0;
 };
 
-// Signed distance of `p` to `collider` and the outward normal there; false for an invalid collider.
-bool colliderDistance(const qv_collider& collider, const double p[3], double& distance, double normal[3]);
+// A flying instance in a contact solve: its frame's momenta as the impulses change them.
+struct ContactBody {
+  qv_instance* instance = nullptr;
+  double velocity[3] = {}, angularMomentum[3] = {};
+  double omega[3] = {};  // the world angular velocity before the solve
+  double reach = 0;      // m: how far its surface can move within the step, beyond its rest radius
+};
+
+// Friction and restitution between two instances (a collider brings its own).
+struct ContactMaterial {
+  double friction = 0.5, restitution = 0;
+};
+
+// Where a solve puts its contacts.
+struct ContactList {
+  Contact* contacts = nullptr;
+  int count = 0, capacity = 0;
+};
+
+// Signed distance of `p` to `collider` and the outward normal there; false for an invalid
+// collider, or (meshes) when p is farther than `reach` from it.
+bool colliderDistance(const qv_collider& collider, const double p[3], double reach, double& distance, double normal[3]);
 bool validCollider(const qv_collider& collider);
 
-// Finds the step's contacts and solves their impulses into the frame's velocity and angular
-// momentum; adds their forces on q. Call after the frame's velocity update, before it moves.
-void solveContacts(qv_instance& s, double h);
+// Finds the step's contacts of `bodies` with `colliders` and with each other, solves their
+// impulses into the frames' velocities and angular momenta, and adds their forces on q. Call after
+// the frames' velocity updates, before they move; all bodies share the time step h.
+void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* colliders, int colliderCount,
+                   const ContactMaterial& between, ContactList& list, double h);
 
 } // namespace quiver::rt

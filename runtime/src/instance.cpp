@@ -175,7 +175,9 @@ void qv_instance::setGravity(const double g[3]) {
   loads.changed = true;
 }
 
-void qv_instance::beginFlight() {
+void qv_instance::beginStep() {
+  lastStep = qv_step_report{};
+  if (!flying()) return;
   const double h = config.time_step;
   frame.refresh(*model, q, v);
   frame.holdSpin();
@@ -189,13 +191,18 @@ void qv_instance::beginFlight() {
   for (int j = 0; j < r; ++j)
     loads.frameForce[j] += model->gravity[j] * body[0] + model->gravity[r + j] * body[1] + model->gravity[2 * r + j] * body[2];
   frame.accelerate(*model, h);
-  quiver::rt::solveContacts(*this, h);
-  frame.move(h);
 }
 
-qv_step_status qv_instance::step() {
-  lastStep = qv_step_report{};
-  if (flying()) beginFlight();
+void qv_instance::solveOwnContacts() {
+  quiver::rt::ContactBody body;
+  body.instance = this;
+  quiver::rt::ContactList list{contacts, 0, config.max_contacts};
+  quiver::rt::solveContacts(&body, 1, colliders, colliderCount, quiver::rt::ContactMaterial{}, list, config.time_step);
+  contactCount = list.count;
+}
+
+qv_step_status qv_instance::finishStep() {
+  if (flying()) frame.move(config.time_step);
   const qv_step_status status = quiver::rt::kIntegrators[config.integrator].step(*this);
   loads.endStep();
   if (status == QV_STEP_RESET || !healthy()) {
@@ -203,6 +210,12 @@ qv_step_status qv_instance::step() {
     return QV_STEP_RESET;
   }
   return status;
+}
+
+qv_step_status qv_instance::step() {
+  beginStep();
+  if (flying()) solveOwnContacts();
+  return finishStep();
 }
 
 void qv_instance::setState(const double* newQ, const double* newV, const double* newA) {

@@ -81,7 +81,11 @@ struct qv_instance {
   // A world force on a vertex: on q (and, in flight, on the frame).
   void addVertexForce(int vertex, const double force[3]);
   void setGravity(const double acceleration[3]);
-  void beginFlight();  // in flight, before the integrator: the frame's forces on q, then the frame's step
+  // A step in three parts, so that a world can solve its instances' contacts between the first and
+  // the last: the frame's forces on q and its momenta (in flight), its contacts, its move and q's step.
+  void beginStep();
+  void solveOwnContacts();
+  qv_step_status finishStep();
   // The snapshot: r, then q, v, a, E(q) and the energy slack, then in flight the frame (position,
   // orientation, velocity, angular momentum, last body omega), as doubles.
   size_t snapshotSize() const { return sizeof(double) * (3 * static_cast<size_t>(r) + 3 + (flying() ? 16 : 0)); }

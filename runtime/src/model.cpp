@@ -9,6 +9,7 @@
 
 #include "block_carver.h"
 #include "formats/model/qvr.h"
+#include "triangle_mesh.h"
 
 namespace quiver::rt {
 
@@ -114,12 +115,26 @@ qv_result loadModel(const void* data, size_t size, const qv_model_config& config
   char* block = static_cast<char*>(allocator.allocate(bytes, 64, allocator.user));
   if (!block) return QV_ERROR_OUT_OF_MEMORY;
   layOut(view, single, allocator, block);
-  *out = reinterpret_cast<qv_model*>(block);
+  qv_model* model = reinterpret_cast<qv_model*>(block);
+  if (model->rigidBody && model->info.triangle_count) {
+    // Its surface for other instances to touch; an open surface only forgoes that.
+    qv_triangle_mesh* surface = nullptr;
+    static_assert(sizeof(unsigned) == sizeof(int), "triangles are passed as int");
+    const qv_result built = createTriangleMesh(model->rest, model->info.vertex_count, reinterpret_cast<const int*>(model->triangles),
+                                               model->info.triangle_count, allocator, &surface, nullptr, 0);
+    if (built == QV_ERROR_OUT_OF_MEMORY) {
+      destroyModel(model);
+      return built;
+    }
+    model->surfaceMesh = surface;
+  }
+  *out = model;
   return QV_OK;
 }
 
 void destroyModel(qv_model* model) {
   const qv_allocator allocator = model->allocator;
+  if (model->surfaceMesh) destroyTriangleMesh(const_cast<qv_triangle_mesh*>(model->surfaceMesh));
   model->~qv_model();
   allocator.release(model, allocator.user);
 }

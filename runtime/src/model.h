@@ -1,6 +1,7 @@
 #pragma once
-// qv_model: a baked model in one block from the caller's allocator, immutable once loaded and
-// shared read-only by every instance of it.
+// qv_model: a baked model in one block from the caller's allocator (and, for a free model, its
+// surface as a triangle mesh in a second), immutable once loaded and shared read-only by every
+// instance of it.
 #include <cstddef>
 
 #include "quiver/quiver.h"
@@ -21,6 +22,9 @@ struct qv_model {
   const double* rigidBody;      // a free object's RIGID_BODY moments (rigid_frame.h), or null
   const double* restStiffness;  // K(0), r x r: linear modal dynamics and modal warping step with it
   double stableStep;            // 2 / omega_max of K(0): central differences' limit
+  // A free model's rest surface, which other instances touch in a world (contact.h); null when the
+  // model is pinned or its surface is not closed.
+  const qv_triangle_mesh* surfaceMesh;
 
   double basisEntry(size_t row, size_t j) const {
     const size_t r = static_cast<size_t>(info.r);

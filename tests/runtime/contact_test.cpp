@@ -9,16 +9,18 @@
 #include "free_bar.h"
 #include "runtime/src/contact.h"
 #include "runtime_fixture.h"
+#include "tests/support/make_collider.h"
 
 namespace quiver {
 namespace {
 
 using test::FreeBar;
+using test::makeCollider;
 
 constexpr double kG = QV_STANDARD_GRAVITY;
 
 qv_collider ground(double friction, double restitution) {
-  return qv_collider{QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, friction, restitution};
+  return makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, friction, restitution);
 }
 
 struct Dropped {
@@ -148,7 +150,7 @@ TEST(Contact, ABounceNeverGainsEnergy) {
   EXPECT_GT(b.rise, 0.7 * e * e * fall);
   EXPECT_LT(b.rise, 1.15 * e * e * fall);  // from its lowest, where it squashed
   // Tumbling onto the ground and a sphere: corners, spin, two colliders.
-  Dropped tumbling(1.0 / 120, {ground(0.3, e), qv_collider{QV_COLLIDER_SPHERE, {1.2, 0.05, 0.2, 0.3, 0, 0, 0, 0}, 0.3, e}},
+  Dropped tumbling(1.0 / 120, {ground(0.3, e), makeCollider(QV_COLLIDER_SPHERE, {1.2, 0.05, 0.2, 0.3, 0, 0, 0, 0}, 0.3, e)},
                    {{0.3, 0.05, 0.6}, {0.96, 0.1, 0.2, 0.15}, {1.5, 0, 0}, {0, 1, 0}}, 0);
   const Bounce t = bounce(tumbling, 360);
   std::printf("tumbling drop: energy %.4g J at the start, at most %+.2e relative above it, %.4g J after 3 s\n", t.start,
@@ -159,37 +161,37 @@ TEST(Contact, ABounceNeverGainsEnergy) {
 TEST(Contact, CollidersMeasureDistanceAsGeometrySays) {
   double d, n[3];
   const double p[3] = {1, 2, 3};
-  ASSERT_TRUE(rt::colliderDistance({QV_COLLIDER_PLANE, {0, 0, 2, 2, 0, 0, 0, 0}, 0, 0}, p, d, n));
+  ASSERT_TRUE(rt::colliderDistance(makeCollider(QV_COLLIDER_PLANE, {0, 0, 2, 2, 0, 0, 0, 0}, 0, 0), p, INFINITY, d, n));
   EXPECT_DOUBLE_EQ(d, 2);  // z = 1, normal +z
   EXPECT_EQ(n[2], 1);
-  ASSERT_TRUE(rt::colliderDistance({QV_COLLIDER_SPHERE, {1, 2, 0, 1, 0, 0, 0, 0}, 0, 0}, p, d, n));
+  ASSERT_TRUE(rt::colliderDistance(makeCollider(QV_COLLIDER_SPHERE, {1, 2, 0, 1, 0, 0, 0, 0}, 0, 0), p, INFINITY, d, n));
   EXPECT_DOUBLE_EQ(d, 2);
-  ASSERT_TRUE(rt::colliderDistance({QV_COLLIDER_BOX, {0, 0, 0, 2, 3, 1, 0, 0}, 0, 0}, p, d, n));
+  ASSERT_TRUE(rt::colliderDistance(makeCollider(QV_COLLIDER_BOX, {0, 0, 0, 2, 3, 1, 0, 0}, 0, 0), p, INFINITY, d, n));
   EXPECT_DOUBLE_EQ(d, 2);  // above the top face z = 1, inside in x and y
   EXPECT_EQ(n[2], 1);
   const double inside[3] = {1.5, 0, 0};
-  ASSERT_TRUE(rt::colliderDistance({QV_COLLIDER_BOX, {0, 0, 0, 2, 3, 1, 0, 0}, 0, 0}, inside, d, n));
+  ASSERT_TRUE(rt::colliderDistance(makeCollider(QV_COLLIDER_BOX, {0, 0, 0, 2, 3, 1, 0, 0}, 0, 0), inside, INFINITY, d, n));
   EXPECT_DOUBLE_EQ(d, -0.5);  // nearest face x = 2
   EXPECT_EQ(n[0], 1);
-  ASSERT_TRUE(rt::colliderDistance({QV_COLLIDER_BOX, {0, 0, 0, 0.5, 1, 2, 0, 0}, 0, 0}, p, d, n));
+  ASSERT_TRUE(rt::colliderDistance(makeCollider(QV_COLLIDER_BOX, {0, 0, 0, 0.5, 1, 2, 0, 0}, 0, 0), p, INFINITY, d, n));
   EXPECT_DOUBLE_EQ(d, std::sqrt(0.25 + 1 + 1));  // past a corner
-  ASSERT_TRUE(rt::colliderDistance({QV_COLLIDER_CAPSULE, {0, 2, 3, 0, 2, 10, 0.5, 0}, 0, 0}, p, d, n));
+  ASSERT_TRUE(rt::colliderDistance(makeCollider(QV_COLLIDER_CAPSULE, {0, 2, 3, 0, 2, 10, 0.5, 0}, 0, 0), p, INFINITY, d, n));
   EXPECT_DOUBLE_EQ(d, 0.5);  // beside the segment
-  ASSERT_TRUE(rt::colliderDistance({QV_COLLIDER_CAPSULE, {0, 2, 5, 0, 2, 10, 0.5, 0}, 0, 0}, p, d, n));
+  ASSERT_TRUE(rt::colliderDistance(makeCollider(QV_COLLIDER_CAPSULE, {0, 2, 5, 0, 2, 10, 0.5, 0}, 0, 0), p, INFINITY, d, n));
   EXPECT_DOUBLE_EQ(d, std::sqrt(5.0) - 0.5);  // past its end cap
 }
 
 TEST(Contact, BadCollidersAndGroundedInstancesAreRefused) {
   FreeBar bar;
   test::Instance flying(bar.model, bar.config(1.0 / 60));
-  const qv_collider bad[] = {{QV_COLLIDER_PLANE, {0, 0, 0, 1, 0, 0, 0, 0}, 0.5, 0},
-                             {QV_COLLIDER_SPHERE, {0, 0, 0, -1, 0, 0, 0, 0}, 0.5, 0},
-                             {QV_COLLIDER_BOX, {0, 0, 0, 1, 1, 0, 0, 0}, 0.5, 0},
-                             {QV_COLLIDER_CAPSULE, {0, 0, 0, 1, 1, 1, 0, 0}, 0.5, 0},
-                             {QV_COLLIDER_SPHERE, {0, NAN, 0, 1, 0, 0, 0, 0}, 0.5, 0},
-                             {QV_COLLIDER_SPHERE, {0, 0, 0, 1, 0, 0, 0, 0}, -1, 0},
-                             {QV_COLLIDER_SPHERE, {0, 0, 0, 1, 0, 0, 0, 0}, 0.5, 1.5},
-                             {static_cast<qv_collider_type>(9), {0, 0, 0, 1, 0, 0, 0, 0}, 0.5, 0}};
+  const qv_collider bad[] = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 0, 1, 0, 0, 0, 0}, 0.5, 0),
+                             makeCollider(QV_COLLIDER_SPHERE, {0, 0, 0, -1, 0, 0, 0, 0}, 0.5, 0),
+                             makeCollider(QV_COLLIDER_BOX, {0, 0, 0, 1, 1, 0, 0, 0}, 0.5, 0),
+                             makeCollider(QV_COLLIDER_CAPSULE, {0, 0, 0, 1, 1, 1, 0, 0}, 0.5, 0),
+                             makeCollider(QV_COLLIDER_SPHERE, {0, NAN, 0, 1, 0, 0, 0, 0}, 0.5, 0),
+                             makeCollider(QV_COLLIDER_SPHERE, {0, 0, 0, 1, 0, 0, 0, 0}, -1, 0),
+                             makeCollider(QV_COLLIDER_SPHERE, {0, 0, 0, 1, 0, 0, 0, 0}, 0.5, 1.5),
+                             makeCollider(static_cast<qv_collider_type>(9), {0, 0, 0, 1, 0, 0, 0, 0}, 0.5, 0)};
   for (const qv_collider& c : bad) EXPECT_EQ(qv_instance_set_colliders(flying.s, &c, 1), QV_ERROR_INVALID_ARGUMENT);
   const qv_collider good = ground(0.5, 0);
   EXPECT_EQ(qv_instance_set_colliders(flying.s, &good, 1), QV_OK);

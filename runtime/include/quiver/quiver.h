@@ -273,20 +273,42 @@ QV_API qv_result qv_instance_set_rigid_state(qv_instance* instance, const qv_rig
    vertices: each step, velocity-level impulses on its frame (restitution, Coulomb friction; stiff at any time
    step), found and solved on the rigid shape it carries, and the same forces on its deformation. At rest a
    vertex sinks by a slop of 1e-3 of the model's diagonal, the contacts' slight softness and its own
-   deformation: 2.2 mm (3.6e-3 of the diagonal) on tests/runtime/contact_test.cpp's soft bar at 1/60 s. Nothing moving faster than the step can see tunnels: a vertex is caught while its frame's
-   motion can reach the collider within the step; a collider thinner than the spacing of the object's
-   surface vertices can pass between them. */
+   deformation: 2.2 mm (3.6e-3 of the diagonal) on tests/runtime/contact_test.cpp's soft bar at 1/60 s.
+   Nothing moving faster than the step can see tunnels: a vertex is caught while its frame's (and the
+   collider's) motion can reach the collider within the step; a collider thinner than the spacing of the
+   object's surface vertices can pass between them. */
 typedef enum qv_collider_type {
   QV_COLLIDER_PLANE = 0,   /* data: nx, ny, nz, d: the points with n . x = d; the object stays on the side n points to */
   QV_COLLIDER_SPHERE = 1,  /* data: x, y, z, radius */
-  QV_COLLIDER_BOX = 2,     /* data: cx, cy, cz, hx, hy, hz: axis-aligned, centre and half extents */
-  QV_COLLIDER_CAPSULE = 3  /* data: x0, y0, z0, x1, y1, z1, radius: the points within radius of the segment */
+  QV_COLLIDER_BOX = 2,     /* data: cx, cy, cz, hx, hy, hz: centre and half extents, turned by `rotation` */
+  QV_COLLIDER_CAPSULE = 3, /* data: x0, y0, z0, x1, y1, z1, radius: the points within radius of the segment */
+  QV_COLLIDER_MESH = 4     /* `mesh`, moved by data: x, y, z and turned by `rotation` about that point */
 } qv_collider_type;
+
+/* A closed triangle mesh for QV_COLLIDER_MESH: its signed distance comes from the closest point (a bounding
+   volume hierarchy) and the angle-weighted pseudo-normal there, exact for any closed mesh, convex or not.
+   Built once (checked: finite, indices in range, no degenerate triangle, every edge shared by exactly two
+   triangles running it in opposite directions; an inward-facing mesh is turned outward); immutable and
+   shared by any number of colliders and threads. On a bad mesh QV_ERROR_FORMAT with what and where. */
+typedef struct qv_triangle_mesh qv_triangle_mesh;
+QV_API qv_result qv_triangle_mesh_create(const double* positions, int vertex_count, const int* triangles,
+                                         int triangle_count, const qv_allocator* allocator, qv_triangle_mesh** mesh,
+                                         char* message, size_t message_size);
+QV_API void qv_triangle_mesh_destroy(qv_triangle_mesh* mesh);
+
 typedef struct qv_collider {
   qv_collider_type type;
   double data[8];      /* m, as the type says; unused entries must be finite */
   double friction;     /* Coulomb coefficient mu, >= 0 */
   double restitution;  /* 0 (no bounce) .. 1 (elastic) */
+  double rotation[3];  /* box and mesh: rotation vector (axis times angle, rad) about the centre; 0: none */
+  /* A kinematic collider (one the game moves): the velocity of its reference point (a sphere's, box's or
+     mesh's centre data[0..2], a capsule's first end, a plane's point nearest the origin) and its angular
+     velocity about it, m/s and rad/s; the contacts see the surface move (a platform lifts, a belt carries).
+     The game moves the collider itself between steps. */
+  double velocity[3];
+  double angular_velocity[3];
+  const qv_triangle_mesh* mesh; /* QV_COLLIDER_MESH: kept by pointer, alive while the collider is used */
 } qv_collider;
 /* The colliders a flying instance meets, `count` of them at `colliders`: kept by pointer (the caller keeps
    the array alive and may change it between steps; each step reads it). QV_ERROR_INVALID_ARGUMENT for an
@@ -295,16 +317,46 @@ QV_API qv_result qv_instance_set_colliders(qv_instance* instance, const qv_colli
 /* The last step's contacts: where, the collider's outward normal, and the impulse it gave (N s, world). */
 typedef struct qv_contact {
   int vertex;
-  int collider;       /* index into the array given to qv_instance_set_colliders */
+  int collider;       /* index into the colliders array; -1 when it touched another instance */
   double point[3];    /* m, the vertex at the step's start */
   double normal[3];
-  double impulse[3];  /* over the step: divide by the time step for the force */
+  double impulse[3];  /* over the step, on this object: divide by the time step for the force */
   double depth;       /* the deformed vertex's signed distance at the step's start: negative where it penetrated
                          (contacts are found and solved on the rigid shape the frame carries; the deformation
                          takes their forces and may sink a vertex by its own displacement) */
+  int instance;       /* in a world: the index (qv_world_add's order) of the instance whose vertex it is */
+  int other;          /* in a world: the index of the instance it touched, -1 for a collider */
 } qv_contact;
 /* Copies up to `capacity` of the last step's contacts into `contacts`; returns how many there were. */
 QV_API int qv_instance_contacts(const qv_instance* instance, qv_contact* contacts, int capacity);
+
+/* A world: flying instances (of one or more models) that touch each other and the world's colliders. Each
+   world step steps every instance once: their frames' forces, then one contact solve over all of them (an
+   instance's surface vertices against the colliders and against the rest surface of every other instance
+   near it, carried by its frame; impulses on both frames and both deformations), then their moves and
+   deformations. Contact between instances is vertex against surface: an edge crossing an edge with no
+   vertex inside is not seen. The world keeps the instances by pointer; an instance's own colliders
+   (qv_instance_set_colliders) are not used in a world. No allocation in the step; deterministic. */
+typedef struct qv_world qv_world;
+typedef struct qv_world_config {
+  int max_instances;  /* default 64 */
+  int max_contacts;   /* all the world's contacts in a step (the deepest kept); default 4096 */
+  double friction;    /* between instances: Coulomb mu, default 0.5 */
+  double restitution; /* between instances: 0..1, default 0 */
+} qv_world_config;
+QV_API void qv_world_config_init(qv_world_config* config);
+QV_API qv_result qv_world_create(const qv_world_config* config, const qv_allocator* allocator, qv_world** world);
+QV_API void qv_world_destroy(qv_world* world);
+/* Adds a flying instance (QV_ERROR_INVALID_ARGUMENT: not flying, already in, its time step differs from the
+   others', or the world is full); returns its index through `index` when not NULL. */
+QV_API qv_result qv_world_add(qv_world* world, qv_instance* instance, int* index);
+/* The world's colliders, kept by pointer as qv_instance_set_colliders keeps them. */
+QV_API qv_result qv_world_set_colliders(qv_world* world, const qv_collider* colliders, int count);
+/* Steps every instance once; returns how many reset (a blown-up state; never expected). */
+QV_API int qv_world_step(qv_world* world);
+/* The last world step's contacts, as qv_instance_contacts (instance and other say who touched whom; the
+   impulse is on `instance`, its opposite on `other`). */
+QV_API int qv_world_contacts(const qv_world* world, qv_contact* contacts, int capacity);
 
 /* Largest stable time step of central differences at rest (2 / omega_max), s. */
 QV_API double qv_instance_stable_time_step(const qv_instance* instance);

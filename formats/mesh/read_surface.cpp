@@ -1,0 +1,69 @@
+#include "formats/mesh/read_surface.h"
+
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <map>
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include "common/mesh_error.h"
+#include "common/surface.h"
+#include "formats/mesh/read_mesh.h"
+
+namespace quiver {
+
+namespace {
+
+bool isTetMeshFile(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".vtu" || ext == ".vtk" || ext == ".msh" || ext == ".mesh" || ext == ".veg" || ext == ".node" ||
+         ext == ".ele";
+}
+
+SurfaceMesh tetBoundary(const std::string& path) {
+  const CheckedMesh checked = loadMesh(path);
+  SurfaceMesh s;
+  for (const Eigen::Vector3d& x : checked.mesh.vertices) s.positions.insert(s.positions.end(), {x[0], x[1], x[2]});
+  for (const auto& t : boundaryTriangles(checked.mesh)) s.triangles.insert(s.triangles.end(), {t[0], t[1], t[2]});
+  return s;
+}
+
+} // namespace
+
+SurfaceMesh readSurfaceFile(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) throw MeshError(path + ": cannot open: no such file");
+  if (isTetMeshFile(path)) return tetBoundary(path);
+  Assimp::Importer importer;
+  // Points and lines are dropped by the importer; what remains is triangles.
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType);
+  if (!scene || !scene->mRootNode) throw MeshError(path + ": cannot read: " + importer.GetErrorString());
+  SurfaceMesh s;
+  std::map<std::array<double, 3>, int> welded;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* mesh = scene->mMeshes[m];
+    std::vector<int> index(mesh->mNumVertices);
+    for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+      const aiVector3D& p = mesh->mVertices[v];
+      const std::array<double, 3> x{p.x, p.y, p.z};
+      if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2]))
+        throw MeshError(path + ": mesh " + std::to_string(m) + ", vertex " + std::to_string(v) + ": coordinate is not finite");
+      const auto [it, added] = welded.emplace(x, static_cast<int>(s.positions.size() / 3));
+      if (added) s.positions.insert(s.positions.end(), x.begin(), x.end());
+      index[v] = it->second;
+    }
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      s.triangles.insert(s.triangles.end(), {index[face.mIndices[0]], index[face.mIndices[1]], index[face.mIndices[2]]});
+    }
+  }
+  if (s.triangles.empty()) throw MeshError(path + ": holds no triangle");
+  return s;
+}
+
+} // namespace quiver
