@@ -390,7 +390,7 @@ qv_result qv_instance_set_colliders(qv_instance* s, const qv_collider* colliders
 
 int qv_instance_contacts(const qv_instance* s, qv_contact* out, int capacity) {
   if (!s) return 0;
-  return copyContacts(ContactList{s->contacts, s->contactCount, s->config.max_contacts}, out, capacity);
+  return copyContacts(s->contacts, out, capacity);
 }
 
 qv_result qv_triangle_mesh_create(const double* positions, int vertex_count, const int* triangles, int triangle_count,

@@ -1,7 +1,9 @@
 #include "contact.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <utility>
 
 #include "triangle_mesh.h"
 
@@ -158,6 +160,15 @@ Contact* admit(ContactList& list, double depth) {
   return list.contacts[slot].depth > depth ? &list.contacts[slot] : nullptr;
 }
 
+// Contacts by who touches what where: the warm start finds last step's by it, and the solve runs
+// in its order whichever contacts the capacity kept.
+bool keyBefore(const Contact& x, const Contact& y) {
+  if (x.body != y.body) return x.body < y.body;
+  if (x.other != y.other) return x.other < y.other;
+  if (x.collider != y.collider) return x.collider < y.collider;
+  return x.vertex < y.vertex;
+}
+
 double bodySpeed(const ContactBody& b) { return norm3(b.velocity) + norm3(b.omega) * b.instance->surfaceRadius; }
 
 // Each surface vertex of body i against every collider.
@@ -279,6 +290,8 @@ bool colliderDistance(const qv_collider& c, const double p[3], double reach, dou
 
 void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* colliders, int colliderCount,
                    const ContactMaterial& material, ContactList& list, double h) {
+  std::swap(list.contacts, list.previous);
+  list.previousCount = list.count;
   list.count = 0;
   for (int i = 0; i < bodyCount; ++i) {
     ContactBody& b = bodies[i];
@@ -297,6 +310,7 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
       if (j != i) findBodyContacts(bodies, i, j, h, material, list);
   }
   if (!list.count) return;
+  std::sort(list.contacts, list.contacts + list.count, keyBefore);
 
   // The relative velocity at a contact: body's frame less the other's (or the collider's surface).
   const auto relativeVelocity = [&](const Contact& ct, double out[3]) {
@@ -340,6 +354,23 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     for (int a = 0; a < 3; ++a) ct.tangent[0][a] = t0[a] / len;
     cross3(ct.normal, ct.tangent[0], ct.tangent[1]);
     for (int t = 0; t < 2; ++t) ct.tangentMass[t] = effectiveMass(ct, ct.tangent[t]);
+  }
+  // Warm start: a contact held since the last step starts from the impulses it ended with (the
+  // friction's turned into this step's tangents, within its disc), as if the last solve went on.
+  for (int j = 0; j < list.count; ++j) {
+    Contact& ct = list.contacts[j];
+    const Contact* last = std::lower_bound(list.previous, list.previous + list.previousCount, ct, keyBefore);
+    if (last == list.previous + list.previousCount || keyBefore(ct, *last) || ct.bounce > 0) continue;
+    double friction[3], J[3];
+    for (int a = 0; a < 3; ++a)
+      friction[a] = last->tangentImpulse[0] * last->tangent[0][a] + last->tangentImpulse[1] * last->tangent[1][a];
+    ct.normalImpulse = last->normalImpulse;
+    for (int t = 0; t < 2; ++t) ct.tangentImpulse[t] = dot3(friction, ct.tangent[t]);
+    const double size = std::hypot(ct.tangentImpulse[0], ct.tangentImpulse[1]), limit = ct.friction * ct.normalImpulse;
+    if (size > limit) ct.tangentImpulse[0] *= limit / size, ct.tangentImpulse[1] *= limit / size;
+    for (int a = 0; a < 3; ++a)
+      J[a] = ct.normalImpulse * ct.normal[a] + ct.tangentImpulse[0] * ct.tangent[0][a] + ct.tangentImpulse[1] * ct.tangent[1][a];
+    apply(ct, J);
   }
   for (int sweep = 0; sweep < kSweeps; ++sweep)
     for (int j = 0; j < list.count; ++j) {

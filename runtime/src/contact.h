@@ -21,30 +21,10 @@
 //   lands and sags where it rests), a bounded load for the implicit step; less the bounce, which the
 //   restitution already returns to the frame (loading q with it too made a bounce gain 31%). The
 //   object touched takes the opposite force at its surface vertex nearest the contact.
+#include "contact_list.h"
 #include "instance.h"
 
 namespace quiver::rt {
-
-struct Contact {
-  int body = 0;              // whose vertex
-  int other = -1;            // the body it touches, or -1 for a collider
-  int vertex = 0;            // body's vertex
-  int otherVertex = 0;       // other's surface vertex nearest the contact, which takes the reaction
-  int collider = -1;
-  double point[3] = {}, normal[3] = {};  // normal: out of the collider or the other body
-  double arm[3] = {}, otherArm[3] = {};  // point - x of body and of other
-  double surfaceVelocity[3] = {};        // a kinematic collider's at the point
-  double depth = 0;          // signed distance of the rigid shape's vertex (negative: penetrating)
-  double deformedDepth = 0;  // of the deformed vertex, reported
-  double target = 0;         // the relative normal velocity the impulse aims at
-  double bounce = 0;         // restitution x the approach speed: the target once the contact holds
-  double normalImpulse = 0;  // accumulated, N s, on body (other takes its opposite)
-  double stopImpulse = 0;    // what it was before the bounce: the part that stops the approach
-  double tangentImpulse[2] = {};
-  double tangent[2][3] = {};
-  double normalMass = 0, tangentMass[2] = {};
-  double friction = 0, restitution = 0;
-};
 
 // A flying instance in a contact solve: its frame's momenta as the impulses change them.
 struct ContactBody {
@@ -57,12 +37,6 @@ struct ContactBody {
 // Friction and restitution between two instances (a collider brings its own).
 struct ContactMaterial {
   double friction = 0.5, restitution = 0;
-};
-
-// Where a solve puts its contacts.
-struct ContactList {
-  Contact* contacts = nullptr;
-  int count = 0, capacity = 0;
 };
 
 // Signed distance of `p` to `collider` and the outward normal there; false for an invalid

@@ -120,7 +120,9 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
   work.polynomialScratch = c.take<double>(quiver::rt::ReducedPolynomial::scratchSize(r));
   if (flying()) {
     frame.attach(c.take<double>(quiver::rt::RigidFrame::scratchDoubles(r)), r);
-    contacts = c.take<quiver::rt::Contact>(static_cast<size_t>(config.max_contacts));
+    contacts.contacts = c.take<quiver::rt::Contact>(static_cast<size_t>(config.max_contacts));
+    contacts.previous = c.take<quiver::rt::Contact>(static_cast<size_t>(config.max_contacts));
+    contacts.capacity = config.max_contacts;
     surfaceVertices = c.take<int>(static_cast<size_t>(model->info.vertex_count));
   }
 }
@@ -131,7 +133,7 @@ void qv_instance::rest() {
   std::memset(a, 0, sizeof(double) * r);
   elasticEnergyAtState = 0;
   energySlack = 0;
-  contactCount = 0;
+  contacts.clear();
   if (flying()) frame.goHome();
 }
 
@@ -196,9 +198,7 @@ void qv_instance::beginStep() {
 void qv_instance::solveOwnContacts() {
   quiver::rt::ContactBody body;
   body.instance = this;
-  quiver::rt::ContactList list{contacts, 0, config.max_contacts};
-  quiver::rt::solveContacts(&body, 1, colliders, colliderCount, quiver::rt::ContactMaterial{}, list, config.time_step);
-  contactCount = list.count;
+  quiver::rt::solveContacts(&body, 1, colliders, colliderCount, quiver::rt::ContactMaterial{}, contacts, config.time_step);
 }
 
 qv_step_status qv_instance::finishStep() {
@@ -257,6 +257,7 @@ bool qv_instance::restoreSnapshot(const double* in) {
   std::memcpy(a, in + 1 + 2 * r, sizeof(double) * r);
   elasticEnergyAtState = in[1 + 3 * r];
   energySlack = in[2 + 3 * r];
+  contacts.clear();  // the snapshot does not carry them: the next step's contacts start cold
   if (flying()) {
     const double* f = in + 3 + 3 * r;
     std::memcpy(frame.position, f, 3 * sizeof(double));

@@ -2,13 +2,10 @@
 // qv_instance: one simulated object, in one block: its settings, its state (q, v, a), its loads
 // and the buffers of the step. Integrators (integrators/) advance it; dynamics.h evaluates it.
 #include "block_carver.h"
+#include "contact_list.h"
 #include "loads.h"
 #include "model.h"
 #include "rigid_frame.h"
-
-namespace quiver::rt {
-struct Contact;
-}
 
 namespace quiver::rt {
 
@@ -64,8 +61,7 @@ struct qv_instance {
   quiver::rt::RigidFrame frame;  // in flight (config.free_flight) only
   const qv_collider* colliders = nullptr;  // the caller's (qv_instance_set_colliders)
   int colliderCount = 0;
-  quiver::rt::Contact* contacts = nullptr;  // the last step's, config.max_contacts at most (contact.h)
-  int contactCount = 0;
+  quiver::rt::ContactList contacts;  // the last step's and the one before, config.max_contacts each (contact.h)
   int* surfaceVertices = nullptr;  // in flight: the contact points
   int surfaceCount = 0;
   double surfaceRadius = 0;        // m: the farthest surface vertex from the centre of mass, at rest

@@ -16,12 +16,15 @@ size_t layOut(const qv_world_config& config, char* block, qv_world** world) {
   qv_instance** instances = c.take<qv_instance*>(static_cast<size_t>(config.max_instances));
   ContactBody* bodies = c.take<ContactBody>(static_cast<size_t>(config.max_instances));
   Contact* contacts = c.take<Contact>(static_cast<size_t>(config.max_contacts));
+  Contact* previous = c.take<Contact>(static_cast<size_t>(config.max_contacts));
   if (block) {
     w = new (w) qv_world{};
     w->config = config;
     w->instances = instances;
     w->bodies = new (bodies) ContactBody[config.max_instances];
-    w->contacts = ContactList{contacts, 0, config.max_contacts};
+    w->contacts.contacts = contacts;
+    w->contacts.previous = previous;
+    w->contacts.capacity = config.max_contacts;
     *world = w;
   }
   return c.size();
@@ -62,7 +65,7 @@ void destroyWorld(qv_world* world) {
 int qv_world::step() {
   for (int i = 0; i < count; ++i) {
     instances[i]->beginStep();
-    instances[i]->contactCount = 0;
+    instances[i]->contacts.clear();
     bodies[i].instance = instances[i];
   }
   const quiver::rt::ContactMaterial between{config.friction, config.restitution};

@@ -50,7 +50,7 @@ TEST(Contact, AtRestOnAPlaneItCarriesExactlyItsWeight) {
   std::printf("at rest: contact force %.6g N for a weight of %.6g N, creep %.3g m/s, deepest penetration %.3g m "
               "(landing %.3g m)\n", mean, weight, std::sqrt(creep), deepest, landing);
   EXPECT_NEAR(mean, weight, 1e-3 * weight);
-  EXPECT_LT(std::sqrt(creep), 5e-4);                 // over the last second
+  EXPECT_LT(std::sqrt(creep), 1e-6);                 // over the last second (1.7e-4 before the warm start)
   EXPECT_LT(deepest, 5e-3 * 0.62);                   // the slop (1e-3 of the diagonal), the softness, the deformation
   EXPECT_LT(landing, 6e-3 * 0.62);
   EXPECT_NEAR(after.position[2], 0.05, 3e-3 * 0.62);  // resting on its underside

@@ -1,0 +1,39 @@
+#pragma once
+// The contacts of a step (contact.h), and the last step's, kept to warm-start the next: a contact
+// seen again (same vertex against the same collider or body) starts from the impulse it ended with,
+// so that a stack's impulses converge over steps rather than restarting from zero each step.
+
+namespace quiver::rt {
+
+struct Contact {
+  int body = 0;              // whose vertex
+  int other = -1;            // the body it touches, or -1 for a collider
+  int vertex = 0;            // body's vertex
+  int otherVertex = 0;       // other's surface vertex nearest the contact, which takes the reaction
+  int collider = -1;
+  double point[3] = {}, normal[3] = {};  // normal: out of the collider or the other body
+  double arm[3] = {}, otherArm[3] = {};  // point - x of body and of other
+  double surfaceVelocity[3] = {};        // a kinematic collider's at the point
+  double depth = 0;          // signed distance of the rigid shape's vertex (negative: penetrating)
+  double deformedDepth = 0;  // of the deformed vertex, reported
+  double target = 0;         // the relative normal velocity the impulse aims at
+  double bounce = 0;         // restitution x the approach speed: the target once the contact holds
+  double normalImpulse = 0;  // accumulated, N s, on body (other takes its opposite)
+  double stopImpulse = 0;    // what it was before the bounce: the part that stops the approach
+  double tangentImpulse[2] = {};
+  double tangent[2][3] = {};
+  double normalMass = 0, tangentMass[2] = {};
+  double friction = 0, restitution = 0;
+};
+
+// Where a solve puts its contacts: `contacts` this step's, `previous` the last step's (sorted by
+// key); two arrays of `capacity` that trade places each step.
+struct ContactList {
+  Contact* contacts = nullptr;
+  Contact* previous = nullptr;
+  int count = 0, previousCount = 0, capacity = 0;
+
+  void clear() { count = previousCount = 0; }
+};
+
+} // namespace quiver::rt
