@@ -42,9 +42,15 @@ Image picture(const Camera& cam, int width, int height, const std::vector<float>
 void renderFlight(const RuntimeModel& model, const RenderOptions& o, int width, int height) {
   RuntimeTarget target(model, o.scenario.step);
   FrameWriter frames(o.output, o.every * target.timeStep());
-  std::vector<std::vector<float>> shots;
-  const auto keep = [&] { shots.push_back(target.instance().positions()); };
-  if (frames.animated()) keep();
+  std::vector<std::vector<float>> shots;  // all bodies' positions, one after the other
+  const auto keep = [&] {
+    std::vector<float> all;
+    for (int k = 0; k < target.bodyCount(); ++k) {
+      const std::vector<float> p = target.body(k).positions();
+      all.insert(all.end(), p.begin(), p.end());
+    }
+    shots.push_back(std::move(all));
+  };
   runScenario(target, model.mesh(), o.scenario, [&](int step) {
     if (frames.animated() ? step % o.every == 0 : step == o.scenario.steps) keep();
   });
@@ -57,7 +63,10 @@ void renderFlight(const RuntimeModel& model, const RenderOptions& o, int width, 
   for (int k = 0; k < target.colliders().size(); ++k)
     appendCollider(target.colliders()[k], target.colliders().surface(k), lo, hi, world);
   const Camera cam = Camera::framing(lo - grow, hi + grow, width, height);
-  const std::vector<unsigned> triangles = model.triangles();
+  std::vector<unsigned> triangles;
+  const std::vector<unsigned> one = model.triangles();
+  for (int k = 0; k < target.bodyCount(); ++k)
+    for (unsigned index : one) triangles.push_back(index + static_cast<unsigned>(k * model.info().vertex_count));
   for (const auto& p : shots) {
     Image image(width, height);
     image.clear(kWhite);
@@ -155,7 +164,6 @@ int renderModel(const std::string& path, const RenderOptions& o) {
     if (frames.animated()) throw std::runtime_error("nothing moves: give a scenario (--force, --drag, --twist, --gravity) or --modes");
     draw();
   } else {
-    if (frames.animated()) draw();
     const ScenarioResult result = runScenario(target, model.mesh(), o.scenario, [&](int step) {
       if (frames.animated() ? step % o.every == 0 : step == o.scenario.steps) draw();
     });

@@ -36,6 +36,11 @@ void SimOptions::addScenarioTo(CLI::App& app) {
                  "Free flight: a collider, repeatable: plane:nx,ny,nz,d (points with n.x = d), sphere:x,y,z,radius, "
                  "box:cx,cy,cz,hx,hy,hz (axis-aligned), capsule:x0,y0,z0,x1,y1,z1,radius, mesh:FILE[,x,y,z] (a closed "
                  "surface: OBJ, STL, PLY, glTF, FBX, ... or a tet mesh's boundary; moved by x,y,z)");
+  app.add_option("--pile", pile,
+                 "Free flight: N copies of the model in layers of four above --position, in one world where they "
+                 "touch each other and the colliders (loads act on the first)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 4096));
   app.add_option("--friction", friction, "Free flight: Coulomb friction of the colliders")->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_option("--restitution", restitution, "Free flight: restitution of the colliders, 0..1")
       ->capture_default_str()
@@ -105,8 +110,8 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
   const std::vector<int> group = selectGroup(mesh, o.group);
   const bool dragMode = o.twist != 0 || o.drag != std::vector<double>{0, 0, 0};
   const std::vector<double> none{0, 0, 0};
-  if (!o.step.freeFlight && (o.position != none || o.velocity != none || o.angularVelocity != none || !o.colliders.empty()))
-    throw std::runtime_error("--position, --velocity, --angular-velocity and --collider need --free");
+  if (!o.step.freeFlight && (o.position != none || o.velocity != none || o.angularVelocity != none || !o.colliders.empty() || o.pile > 1))
+    throw std::runtime_error("--position, --velocity, --angular-velocity, --collider and --pile need --free");
   if (o.step.freeFlight) target.startFlight(o);
   if (o.gravity) {
     const double g[3] = {0, 0, -kGravity};
@@ -125,6 +130,7 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
   if (!o.output.empty() && std::filesystem::path(o.output).has_parent_path())
     std::filesystem::create_directories(std::filesystem::path(o.output).parent_path());
   const double h = target.timeStep();
+  if (afterStep) afterStep(0);  // the start, set up
   for (int step = 0; step < o.steps; ++step) {
     if (step < o.holdSteps && dragMode) {
       const double s = static_cast<double>(step + 1) / o.holdSteps;

@@ -29,6 +29,7 @@ struct SimOptions {
   std::vector<double> velocity{0, 0, 0};         // m/s
   std::vector<double> angularVelocity{0, 0, 0};  // rad/s, about the centre of mass
   std::vector<std::string> colliders;            // --collider TYPE:NUMBERS (ColliderSet::add), free flight only
+  int pile = 1;                                  // --pile N: N copies in one world, touching each other
   double friction = 0.5;                         // Coulomb mu of every collider
   double restitution = 0.2;                      // of every collider, 0..1
   StepSettings step;                    // integrator, elasticity, time step, Newton iterations per step
@@ -75,7 +76,7 @@ struct ScenarioResult {
 std::vector<int> selectGroup(const TetMesh& mesh, const std::string& selector);
 
 // Runs the scenario on `target` over `mesh` (rest shape, and tets for the .vtu frames), calling
-// `afterStep` (if given) with the number of steps taken so far after each one.
+// `afterStep` (if given) with the number of steps taken so far: 0 once set up, then after each step.
 ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const SimOptions& options,
                            const std::function<void(int)>& afterStep = {});
 

@@ -169,13 +169,17 @@ bool keyBefore(const Contact& x, const Contact& y) {
   return x.vertex < y.vertex;
 }
 
-double bodySpeed(const ContactBody& b) { return norm3(b.velocity) + norm3(b.omega) * b.instance->surfaceRadius; }
+// How fast body b's surface can move relative to something moving at `velocity`: the frame's
+// relative velocity plus its spin at its farthest vertex.
+double relativeSpeed(const ContactBody& b, const double velocity[3]) {
+  const double d[3] = {b.velocity[0] - velocity[0], b.velocity[1] - velocity[1], b.velocity[2] - velocity[2]};
+  return norm3(d) + norm3(b.omega) * b.instance->surfaceRadius;
+}
 
 // Each surface vertex of body i against every collider.
 void findColliderContacts(const ContactBody* bodies, int i, const qv_collider* colliders, int count, double h,
                           ContactList& list) {
   const qv_instance& s = *bodies[i].instance;
-  const double speed = bodySpeed(bodies[i]);
   for (int k = 0; k < count; ++k) {
     const qv_collider& col = colliders[k];
     for (int n = 0; n < s.surfaceCount; ++n) {
@@ -183,7 +187,7 @@ void findColliderContacts(const ContactBody* bodies, int i, const qv_collider* c
       double p[3], u[3], depth, normal[3];
       worldVertex(s, v, false, p);
       surfaceVelocity(col, p, u);
-      const double margin = s.contactSlop + 2 * h * (speed + norm3(u));
+      const double margin = s.contactSlop + 2 * h * relativeSpeed(bodies[i], u);
       if (!colliderDistance(col, p, margin, depth, normal) || depth > margin) continue;
       Contact* ct = admit(list, depth);
       if (!ct) continue;
@@ -206,7 +210,9 @@ void findBodyContacts(const ContactBody* bodies, int i, int j, double h, const C
                       ContactList& list) {
   const qv_instance &a = *bodies[i].instance, &b = *bodies[j].instance;
   if (!b.model->surfaceMesh) return;
-  const double margin = std::fmax(a.contactSlop, b.contactSlop) + 2 * h * (bodySpeed(bodies[i]) + bodySpeed(bodies[j]));
+  // Bodies falling side by side need no contacts: their relative motion sets the margin.
+  const double margin = std::fmax(a.contactSlop, b.contactSlop) +
+                        2 * h * (relativeSpeed(bodies[i], bodies[j].velocity) + norm3(bodies[j].omega) * b.surfaceRadius);
   double gap[3];
   for (int k = 0; k < 3; ++k) gap[k] = a.frame.position[k] - b.frame.position[k];
   if (norm3(gap) > a.surfaceRadius + b.surfaceRadius + margin) return;
@@ -221,9 +227,14 @@ void findBodyContacts(const ContactBody* bodies, int i, int j, double h, const C
     *ct = Contact{};
     ct->body = i, ct->other = j, ct->vertex = v, ct->otherVertex = otherVertex, ct->depth = depth;
     ct->friction = material.friction, ct->restitution = material.restitution;
-    double deformed[3], ignored[3];
+    // Reported: the deformed vertex against the other's surface, moved where the other's nearest
+    // vertex moved along the normal (both deform).
+    double deformed[3], ignored[3], u[3], uWorld[3];
     worldVertex(a, v, true, deformed);
-    if (!bodyDistance(b, deformed, INFINITY, ct->deformedDepth, ignored, nullptr)) ct->deformedDepth = depth;
+    bodyDistance(b, deformed, INFINITY, ct->deformedDepth, ignored, nullptr);
+    b.model->vertexLinear(otherVertex, b.q, u, nullptr);
+    b.frame.toWorldDirection(u, uWorld);
+    ct->deformedDepth -= dot3(uWorld, normal);
     for (int k = 0; k < 3; ++k) {
       ct->point[k] = p[k], ct->normal[k] = normal[k];
       ct->arm[k] = p[k] - a.frame.position[k];
@@ -343,6 +354,7 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     ct.target = ct.depth > slop ? -ct.depth / h : 0.2 * (-ct.depth - slop) / h;
     ct.bounce = vn < -bounceSpeed ? -ct.restitution * vn : 0.0;
     ct.normalMass = effectiveMass(ct, ct.normal);
+    ct.restingImpulse = 4 * ct.normalMass * (norm3(s.frame.gravity) * h + slop / h);
     // Tangents: the sliding direction first (any, when not sliding).
     double t0[3] = {vel[0] - vn * ct.normal[0], vel[1] - vn * ct.normal[1], vel[2] - vn * ct.normal[2]};
     double len = norm3(t0);
@@ -384,12 +396,15 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
       }
       double vel[3];
       relativeVelocity(ct, vel);
-      // Normal: accumulated impulse >= 0. Slightly soft (compliance kSoftness / normalMass): a
-      // resting face shares its weight among its contacts by how deep each is, rather than as the
-      // sweep order happens to (which dents a soft object under a few loaded vertices).
-      const double before = ct.normalImpulse;
-      ct.normalImpulse = std::fmax(0.0, before + (ct.target - dot3(vel, ct.normal) - kSoftness * before / ct.normalMass) /
-                                                 ((1 + kSoftness) / ct.normalMass));
+      // Normal: accumulated impulse >= 0. Slightly soft (compliance kSoftness / normalMass) up to
+      // the impulses resting takes: a resting face shares its weight among its contacts by how deep
+      // each is, rather than as the sweep order happens to (which dents a soft object under a few
+      // loaded vertices); an impact's impulse beyond that is stiff (softness let 10% of a landing's
+      // speed through: 5 mm in a step at 3 m/s).
+      const double before = ct.normalImpulse, soft = std::fmin(before, ct.restingImpulse);
+      const double stiff = ct.normalImpulse > ct.restingImpulse ? 1.0 : 1 + kSoftness;
+      ct.normalImpulse = std::fmax(0.0, before + (ct.target - dot3(vel, ct.normal) - kSoftness * soft / ct.normalMass) /
+                                                 (stiff / ct.normalMass));
       double J[3];
       for (int a = 0; a < 3; ++a) J[a] = (ct.normalImpulse - before) * ct.normal[a];
       apply(ct, J);

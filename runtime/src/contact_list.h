@@ -20,6 +20,7 @@ struct Contact {
   double bounce = 0;         // restitution x the approach speed: the target once the contact holds
   double normalImpulse = 0;  // accumulated, N s, on body (other takes its opposite)
   double stopImpulse = 0;    // what it was before the bounce: the part that stops the approach
+  double restingImpulse = 0; // beyond it the contact is stiff: what resting under a stack takes
   double tangentImpulse[2] = {};
   double tangent[2][3] = {};
   double normalMass = 0, tangentMass[2] = {};
