@@ -75,18 +75,64 @@ class FreeFlight(unittest.TestCase):
         self.assertLess(j["final_center"][2], 0.3)
         self.assertEqual(j["resets"], 0)
 
+    def write_slab(self, name, drop_last=False):
+        """A closed 2 x 2 x 1 m slab centred at the origin as an OBJ file (quads, 1-based), or open."""
+        path = os.path.join(self.tmp.name, name)
+        corners = [(x, y, z) for z in (-0.5, 0.5) for y in (-1, 1) for x in (-1, 1)]
+        quads = [(1, 5, 7, 3), (2, 4, 8, 6), (1, 2, 6, 5), (3, 7, 8, 4), (1, 3, 4, 2), (5, 6, 8, 7)]
+        with open(path, "w") as f:
+            f.write("# a slab\n" + "".join(f"v {x} {y} {z}\n" for x, y, z in corners))
+            f.write("".join("f " + " ".join(map(str, q)) + "\n" for q in quads[:5 if drop_last else 6]))
+        return path
+
+    def test_a_mesh_collider_holds_it_as_the_box_it_encloses(self):
+        # The same slab as a box and as an OBJ mesh moved by its translation: the same landing and rest.
+        slab = self.write_slab("slab.obj")
+        common = ["--free", "--gravity", "--position", "0,0,0.3", "--angular-velocity", "1,2,0", "--alpha", 5,
+                  "--steps", 120, "--hold", 0, "--json"]
+        box = json.loads(run(QUIVER, "sim", self.free + ".qvr", *common, "--collider", "box:0.3,0,-0.5,1,1,0.5").stdout)
+        mesh = json.loads(run(QUIVER, "sim", self.free + ".qvr", *common, "--collider", f"mesh:{slab},0.3,0,-0.5").stdout)
+        print(f"on a box: rests at {box['final_center']}; on the same slab as an OBJ mesh: {mesh['final_center']}")
+        np.testing.assert_allclose(mesh["final_center"], box["final_center"], atol=1e-9)
+        self.assertLess(mesh["final_speed_mps"], 0.01)
+        self.assertGreater(mesh["final_center"][2], 0.04)
+
+    def test_a_pile_of_twenty_comes_to_rest(self):
+        walls = ["box:0,0.95,0.1,1,0.05,0.1", "box:0,-0.95,0.1,1,0.05,0.1", "box:0.95,0,0.1,0.05,1,0.1", "box:-0.95,0,0.1,0.05,1,0.1"]
+        p = run(QUIVER, "sim", self.free + ".qvr", "--free", "--gravity", "--pile", 20, "--position", "0,0,0.2",
+                "--collider", "plane:0,0,1,0", *[a for w in walls for a in ("--collider", w)], "--alpha", 5,
+                "--steps", 360, "--hold", 0, "--json")
+        j = json.loads(p.stdout)
+        heights = sorted(c[2] for c in j["final_centers"])
+        print(f"pile of {j['bodies']}: fastest {j['max_final_speed_mps']:.2g} m/s after 6 s, centres {heights[0]:.3f} to "
+              f"{heights[-1]:.3f} m high, deepest {j['max_penetration_m'] * 1000:.2g} mm, {j['step_us_median']:.0f} us a step")
+        self.assertEqual(j["bodies"], 20)
+        self.assertEqual(j["resets"], 0)
+        self.assertLess(j["max_final_speed_mps"], 1e-3)
+        self.assertGreater(heights[0], 0.04)  # none through the ground
+        self.assertGreater(heights[-1], 0.25)  # piled up, not one layer
+        for x, y, _ in j["final_centers"]:
+            self.assertLess(max(abs(x), abs(y)), 0.9)  # inside the walls
+
     def test_bad_colliders_are_named(self):
-        for value, message in (("mesh:x.obj", "mesh colliders are not there yet"), ("sphere:1,2,3", "expected sphere:x,y,z,radius"),
+        open_slab = self.write_slab("open.obj", drop_last=True)
+        empty = os.path.join(self.tmp.name, "empty.obj")
+        with open(empty, "w") as f:
+            f.write("v 0 0 0\n")
+        for value, message in ((f"mesh:{open_slab}", "4 edges with one triangle (open)"),
+                               ("mesh:missing.obj", "missing.obj: cannot open"), (f"mesh:{empty}", "empty.obj"),
+                               ("mesh:", "expected mesh:FILE[,x,y,z]"), ("sphere:1,2,3", "expected sphere:x,y,z,radius"),
                                ("sphere:1,2,3,-1", "sizes must be positive"), ("plane:0,0,0,1", "normal not zero"),
-                               ("box:1,2,3,a,1,1", "expected box:cx,cy,cz,hx,hy,hz"), ("cone:1", "plane, sphere, box or capsule")):
+                               ("box:1,2,3,a,1,1", "expected box:cx,cy,cz,hx,hy,hz"), ("cone:1", "plane, sphere, box, capsule or mesh")):
             with self.subTest(value=value):
                 p = run(QUIVER, "sim", self.free + ".qvr", "--free", "--collider", value, "--steps", 2, codes=(1,))
                 self.assertIn(message, p.stderr)
                 self.assertIn(value, p.stderr)
 
     def test_what_needs_free_says_so(self):
-        p = run(QUIVER, "sim", self.free + ".qvr", "--velocity", "1,0,0", "--steps", 2, codes=(1,))
-        self.assertIn("need --free", p.stderr)
+        for option in (["--velocity", "1,0,0"], ["--pile", 3]):
+            p = run(QUIVER, "sim", self.free + ".qvr", *option, "--steps", 2, codes=(1,))
+            self.assertIn("need --free", p.stderr)
         p = run(QUIVER, "sim", self.pinned + ".qvr", "--free", "--steps", 2, codes=(1,))
         self.assertIn("pinned.qvr was baked with fixed vertices", p.stderr)
         p = run(QUIVER, "sim", self.free + ".qvr", "--free", "--angular-velocity", "nan,0,0", "--steps", 2, codes=(1,))
