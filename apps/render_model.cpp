@@ -45,8 +45,8 @@ void renderFlight(const RuntimeModel& model, const RenderOptions& o, int width, 
   std::vector<std::vector<float>> shots;  // all bodies' positions, one after the other
   const auto keep = [&] {
     std::vector<float> all;
-    for (int k = 0; k < target.bodyCount(); ++k) {
-      const std::vector<float> p = target.body(k).positions();
+    for (int k = 0; k < target.flight()->bodyCount(); ++k) {
+      const std::vector<float> p = target.flight()->body(k).positions();
       all.insert(all.end(), p.begin(), p.end());
     }
     shots.push_back(std::move(all));
@@ -60,12 +60,12 @@ void renderFlight(const RuntimeModel& model, const RenderOptions& o, int width, 
       for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], double(p[3 * v + a])), hi[a] = std::max(hi[a], double(p[3 * v + a]));
   const Eigen::Vector3d grow = Eigen::Vector3d::Constant(0.1 * (hi - lo).norm());
   TriangleSoup world;
-  for (int k = 0; k < target.colliders().size(); ++k)
-    appendCollider(target.colliders()[k], target.colliders().surface(k), lo, hi, world);
+  const ColliderSet& colliders = target.flight()->colliders();
+  for (int k = 0; k < colliders.size(); ++k) appendCollider(colliders[k], colliders.surface(k), lo, hi, world);
   const Camera cam = Camera::framing(lo - grow, hi + grow, width, height);
   std::vector<unsigned> triangles;
   const std::vector<unsigned> one = model.triangles();
-  for (int k = 0; k < target.bodyCount(); ++k)
+  for (int k = 0; k < target.flight()->bodyCount(); ++k)
     for (unsigned index : one) triangles.push_back(index + static_cast<unsigned>(k * model.info().vertex_count));
   for (const auto& p : shots) {
     Image image(width, height);

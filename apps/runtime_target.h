@@ -5,7 +5,6 @@
 #include <vector>
 
 #include "apps/sim_scenario.h"
-#include "apps/support/collider_set.h"
 #include "apps/support/runtime_model.h"
 
 namespace quiver::app {
@@ -25,27 +24,19 @@ public:
   double timeStep() const override { return instance_.config().time_step; }
 
   const RuntimeInstance& instance() const { return instance_; }
-  // With --pile N: N bodies in one world (body 0 is instance()); otherwise 1.
-  int bodyCount() const { return 1 + static_cast<int>(copies_.size()); }
-  const RuntimeInstance& body(int i) const { return i == 0 ? instance_ : *copies_[static_cast<size_t>(i - 1)]; }
+  // In flight: its bodies (body 0 is instance()) and colliders; null before startFlight().
+  const FlightWorld* flight() const { return flight_.get(); }
   int indefiniteSteps() const { return indefinite_; }
   int heldBackSteps() const { return heldBack_; }
   double energyRemoved() const { return energyRemoved_; }  // J, by the minimising solver's energy budget
   double maxPenetration() const { return maxPenetration_; }  // m, the deepest contact seen
-  const ColliderSet& colliders() const { return colliders_; }
 
 private:
   const RuntimeModel& model_;
   RuntimeInstance instance_;
   int indefinite_ = 0, heldBack_ = 0;
   double energyRemoved_ = 0;
-  ColliderSet colliders_;  // the instance (or the world) reads them by pointer
-  struct WorldRelease {
-    void operator()(qv_world* world) const { qv_world_destroy(world); }
-  };
-  std::vector<std::unique_ptr<RuntimeInstance>> copies_;  // --pile: the other bodies
-  std::unique_ptr<qv_world, WorldRelease> world_;          // --pile: all bodies
-  std::vector<qv_contact> contacts_;
+  std::unique_ptr<FlightWorld> flight_;
   double maxPenetration_ = 0;
 };
 

@@ -38,17 +38,18 @@ int simulateModel(const std::string& path, const SimOptions& o) {
       j["final_center"] = {flight.position[0], flight.position[1], flight.position[2]};  // world centre of mass, m
       j["final_speed_mps"] = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
       j["max_penetration_m"] = target.maxPenetration();
-      if (target.bodyCount() > 1) {  // --pile: every body's centre and the fastest of them
+      const FlightWorld& bodies = *target.flight();
+      if (bodies.bodyCount() > 1) {  // --pile: every body's centre and the fastest of them
         double fastest = 0;
         nlohmann::json centres = nlohmann::json::array();
-        for (int k = 0; k < target.bodyCount(); ++k) {
+        for (int k = 0; k < bodies.bodyCount(); ++k) {
           qv_rigid_state s;
-          qv_instance_get_rigid_state(target.body(k).get(), &s);
+          qv_instance_get_rigid_state(bodies.body(k).get(), &s);
           centres.push_back({s.position[0], s.position[1], s.position[2]});
           fastest = std::max(fastest, std::sqrt(s.linear_velocity[0] * s.linear_velocity[0] + s.linear_velocity[1] * s.linear_velocity[1] +
                                                 s.linear_velocity[2] * s.linear_velocity[2]));
         }
-        j["bodies"] = target.bodyCount();
+        j["bodies"] = bodies.bodyCount();
         j["final_centers"] = centres;
         j["max_final_speed_mps"] = fastest;
       }

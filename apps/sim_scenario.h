@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "apps/support/flight_world.h"
 #include "apps/support/step_settings.h"
 #include "common/tet_mesh.h"
 
@@ -24,14 +25,7 @@ struct SimOptions {
   std::string axis = "x";               // x | y | z: the twist axis
   double stiffness = 1e4;               // N/m per vertex, drag mode's penalty springs
   bool gravity = false;                 // add g = 9.81 m/s^2 along -z
-  // Free flight (--free, step.freeFlight): where and how the object starts, in the world.
-  std::vector<double> position{0, 0, 0};         // m, the model translated from where it was baked
-  std::vector<double> velocity{0, 0, 0};         // m/s
-  std::vector<double> angularVelocity{0, 0, 0};  // rad/s, about the centre of mass
-  std::vector<std::string> colliders;            // --collider TYPE:NUMBERS (ColliderSet::add), free flight only
-  int pile = 1;                                  // --pile N: N copies in one world, touching each other
-  double friction = 0.5;                         // Coulomb mu of every collider
-  double restitution = 0.2;                      // of every collider, 0..1
+  FlightSetup flight;                   // --free (step.freeFlight): where the bodies start, what they touch
   StepSettings step;                    // integrator, elasticity, time step, Newton iterations per step
                                         // (runtime; full space: at most), Rayleigh damping
   std::string output;                   // NAME: NAME.pvd, NAME_NNNNN.vtu, NAME.csv; "" for none

@@ -28,7 +28,7 @@ struct Recorder : ScenarioTarget {
 
   void addVertexForce(int v, const double f[3]) override { steps.back().forces.emplace_back(v, Eigen::Vector3d(f)); }
   void setGravity(const double g[3]) override { gravity = Eigen::Vector3d(g); }
-  void startFlight(const SimOptions& o) override { flight = Eigen::Vector3d(o.velocity.data()); }
+  void startFlight(const SimOptions& o) override { flight = Eigen::Vector3d(o.flight.velocity.data()); }
   Eigen::Vector3d flight = Eigen::Vector3d::Constant(-1);  // the velocity it was started with
   void setSprings(const std::vector<int>&, const std::vector<double>& t, double k) override {
     steps.back().springs = true;
@@ -148,7 +148,7 @@ TEST(Scenario, AGroupThatSelectsNothingIsNamed) {
 TEST(Scenario, FlightStartsFromTheOptionsAndNeedsFree) {
   SimOptions o;
   o.steps = 1;
-  o.velocity = {1, 2, 3};
+  o.flight.velocity = {1, 2, 3};
   Recorder target;
   try {
     runScenario(target, box(), o);

@@ -1,0 +1,96 @@
+#include "apps/support/flight_world.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace quiver::app {
+
+namespace {
+
+// Where body k of `count` goes: layers of four on a 2 x 2 grid spaced by the model's width, each
+// layer turned a quarter about z from the one below and raised by 1.5 x the model's height, each
+// body turned a little more so that the pile does not stand in perfect columns. A single body stays.
+void pileSlot(const qv_model_info& info, int k, int count, double offset[3], double quaternion[4]) {
+  offset[0] = offset[1] = offset[2] = 0;
+  quaternion[0] = 1, quaternion[1] = quaternion[2] = quaternion[3] = 0;
+  if (count == 1) return;
+  const double dx = info.bbox_max[0] - info.bbox_min[0], dy = info.bbox_max[1] - info.bbox_min[1],
+               dz = info.bbox_max[2] - info.bbox_min[2];
+  const double spacing = 0.6 * std::hypot(dx, dy);
+  const int layer = k / 4, slot = k % 4;
+  offset[0] = (slot == 1 || slot == 3 ? 1 : -1) * spacing;
+  offset[1] = (slot >= 2 ? 1 : -1) * spacing;
+  offset[2] = 1.5 * dz * layer;
+  const double yaw = M_PI / 2 * layer + 0.15 * slot;
+  quaternion[0] = std::cos(yaw / 2), quaternion[3] = std::sin(yaw / 2);
+}
+
+} // namespace
+
+FlightWorld::FlightWorld(const RuntimeModel& model, const RuntimeInstance& first, const FlightSetup& o) : first_(first) {
+  const int count = std::max(1, o.pile);
+  if (count > 1) {
+    qv_world_config config;
+    qv_world_config_init(&config);
+    config.max_instances = count;
+    config.max_contacts = 64 * count;
+    config.friction = o.friction;
+    config.restitution = o.restitution;
+    qv_world* world = nullptr;
+    if (qv_world_create(&config, nullptr, &world) != QV_OK) throw std::runtime_error("--pile: out of memory");
+    world_.reset(world);
+  }
+  for (int k = 0; k < count; ++k) {
+    if (k > 0) copies_.push_back(std::make_unique<RuntimeInstance>(model, first.config()));
+    qv_instance* s = body(k).get();
+    qv_rigid_state state;
+    qv_instance_get_rigid_state(s, &state);  // the pose as baked
+    double offset[3], turn[4];
+    pileSlot(model.info(), k, count, offset, turn);
+    for (int a = 0; a < 3; ++a) {  // turned about the baked centre of mass, then moved
+      state.position[a] += o.position[a] + offset[a];
+      state.linear_velocity[a] = o.velocity[a];
+      state.angular_velocity[a] = o.angularVelocity[a];
+    }
+    std::copy(turn, turn + 4, state.orientation);
+    if (qv_instance_set_rigid_state(s, &state) != QV_OK)
+      throw std::runtime_error("--position, --velocity and --angular-velocity must be finite");
+    if (world_ && qv_world_add(world_.get(), s, nullptr) != QV_OK)
+      throw std::runtime_error("--pile: cannot add body " + std::to_string(k));
+  }
+  const auto use = [&](const qv_collider* colliders, int n) {
+    return world_ ? qv_world_set_colliders(world_.get(), colliders, n) : qv_instance_set_colliders(first_.get(), colliders, n);
+  };
+  for (const std::string& text : o.colliders) {
+    colliders_.add(text, o.friction, o.restitution);
+    if (use(&colliders_[colliders_.size() - 1], 1) != QV_OK)
+      throw std::runtime_error("--collider '" + text + "': sizes must be positive, a plane's normal not zero");
+  }
+  if (use(colliders_.data(), colliders_.size()) != QV_OK)
+    throw std::runtime_error("--friction and --restitution: mu >= 0, restitution in 0..1");
+  contactCapacity_ = world_ ? 64 * count : first.config().max_contacts;
+}
+
+void FlightWorld::setGravity(const double g[3]) {
+  for (int k = 0; k < bodyCount(); ++k) qv_instance_set_gravity(body(k).get(), g);
+}
+
+int FlightWorld::step() {
+  if (world_) return qv_world_step(world_.get());
+  return qv_instance_step(first_.get()) == QV_STEP_RESET ? 1 : 0;
+}
+
+const std::vector<qv_contact>& FlightWorld::contacts() {
+  contacts_.resize(static_cast<size_t>(contactCapacity_));
+  const int n = world_ ? qv_world_contacts(world_.get(), contacts_.data(), contactCapacity_)
+                       : qv_instance_contacts(first_.get(), contacts_.data(), contactCapacity_);
+  contacts_.resize(static_cast<size_t>(std::min(n, contactCapacity_)));
+  return contacts_;
+}
+
+void FlightWorld::restart() {
+  for (int k = 0; k < bodyCount(); ++k) qv_instance_reset(body(k).get());
+}
+
+} // namespace quiver::app
