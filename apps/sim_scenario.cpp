@@ -29,24 +29,7 @@ void SimOptions::addScenarioTo(CLI::App& app) {
   app.add_option("--stiffness", stiffness, "Drag: penalty spring per vertex, N/m")->capture_default_str();
   app.add_flag("--gravity", gravity, "Gravity, 9.81 m/s^2 along -z");
   app.add_flag("--free", step.freeFlight, "Fly: rigid motion with the deformation (a model baked with no fixed vertex)");
-  app.add_option("--position", flight.position, "Free flight: start translated by x,y,z (m) from where the model was baked")
-      ->delimiter(',')->expected(3);
-  app.add_option("--velocity", flight.velocity, "Free flight: initial velocity vx,vy,vz, m/s")->delimiter(',')->expected(3);
-  app.add_option("--collider", flight.colliders,
-                 "Free flight: a collider, repeatable: plane:nx,ny,nz,d (points with n.x = d), sphere:x,y,z,radius, "
-                 "box:cx,cy,cz,hx,hy,hz (axis-aligned), capsule:x0,y0,z0,x1,y1,z1,radius, mesh:FILE[,x,y,z] (a closed "
-                 "surface: OBJ, STL, PLY, glTF, FBX, ... or a tet mesh's boundary; moved by x,y,z)");
-  app.add_option("--pile", flight.pile,
-                 "Free flight: N copies of the model in layers of four above --position, in one world where they "
-                 "touch each other and the colliders (loads act on the first)")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 4096));
-  app.add_option("--friction", flight.friction, "Free flight: Coulomb friction of the colliders")->capture_default_str()->check(CLI::NonNegativeNumber);
-  app.add_option("--restitution", flight.restitution, "Free flight: restitution of the colliders, 0..1")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
-  app.add_option("--angular-velocity", flight.angularVelocity, "Free flight: initial spin wx,wy,wz, rad/s (world axes)")
-      ->delimiter(',')->expected(3);
+  flight.addTo(app);
   app.add_option("--dt", step.timeStep, "Time step, s")->check(Positive);
   app.add_option("--newton", step.newton,
                  "Newton iterations per implicit step: the most (--solver minimize, default 8; full space, default 20) "

@@ -28,6 +28,27 @@ void pileSlot(const qv_model_info& info, int k, int count, double offset[3], dou
 
 } // namespace
 
+void FlightSetup::addTo(CLI::App& app) {
+  app.add_option("--position", position, "Free flight: start translated by x,y,z (m) from where the model was baked")
+      ->delimiter(',')->expected(3);
+  app.add_option("--velocity", velocity, "Free flight: initial velocity vx,vy,vz, m/s")->delimiter(',')->expected(3);
+  app.add_option("--collider", colliders,
+                 "Free flight: a collider, repeatable: plane:nx,ny,nz,d (points with n.x = d), sphere:x,y,z,radius, "
+                 "box:cx,cy,cz,hx,hy,hz (axis-aligned), capsule:x0,y0,z0,x1,y1,z1,radius, mesh:FILE[,x,y,z] (a closed "
+                 "surface: OBJ, STL, PLY, glTF, FBX, ... or a tet mesh's boundary; moved by x,y,z)");
+  app.add_option("--pile", pile,
+                 "Free flight: N copies of the model in layers of four above --position, in one world where they "
+                 "touch each other and the colliders (loads act on the first)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 4096));
+  app.add_option("--friction", friction, "Free flight: Coulomb friction of the colliders")->capture_default_str()->check(CLI::NonNegativeNumber);
+  app.add_option("--restitution", restitution, "Free flight: restitution of the colliders, 0..1")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--angular-velocity", angularVelocity, "Free flight: initial spin wx,wy,wz, rad/s (world axes)")
+      ->delimiter(',')->expected(3);
+}
+
 FlightWorld::FlightWorld(const RuntimeModel& model, const RuntimeInstance& first, const FlightSetup& o) : first_(first) {
   const int count = std::max(1, o.pile);
   if (count > 1) {

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
 #include "apps/support/collider_set.h"
 #include "apps/support/runtime_model.h"
 
@@ -19,6 +21,9 @@ struct FlightSetup {
   int pile = 1;                                  // --pile N: N copies in one world, touching each other
   double friction = 0.5;                         // Coulomb mu of every collider (and between bodies)
   double restitution = 0.2;                      // of every collider (and between bodies), 0..1
+
+  // --position, --velocity, --angular-velocity, --collider, --pile, --friction, --restitution.
+  void addTo(CLI::App& app);
 };
 
 class FlightWorld {

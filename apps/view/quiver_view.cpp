@@ -1,6 +1,8 @@
 // quiver-view: a baked model, live. Drag a surface point with the mouse (a spring to the cursor
 // ray), let go and watch it ring; change integrator, time step, damping and gravity; browse the
-// linear modes and basis vectors. Steps at the model's fixed rate, whatever the frame rate.
+// linear modes and basis vectors. With --free, a free model (or a --pile of them) drops onto a
+// ground and the colliders: lift, drag and throw it; R drops it again. Steps at the model's fixed
+// rate, whatever the frame rate.
 // `--frames N --screenshot out.png [--drag-script FILE]` runs a bounded, deterministic session
 // (1/60 s per frame) for tests and recordings.
 #include <algorithm>
@@ -17,6 +19,7 @@
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 
+#include "apps/render/collider_mesh.h"
 #include "apps/render/software_renderer.h"
 #include "apps/support/mesh_options.h"
 #include "apps/view/drag_script.h"
@@ -39,7 +42,27 @@ struct ViewOptions {
   bool noPanel = false;
   std::string showMode;  // "linear:N" or "basis:N": start in the mode browser
   ViewSettings settings;
+  FlightSetup flight;    // with --free (settings.step.freeFlight)
 };
+
+// Free flight's defaults in the viewer: with no collider, a ground plane under the model as baked,
+// and the model starting one height above it (so that it drops).
+FlightSetup withViewerDefaults(FlightSetup flight, const qv_model_info& info) {
+  if (!flight.colliders.empty()) return flight;
+  flight.colliders.push_back("plane:0,0,1," + std::to_string(info.bbox_min[2]));
+  if (flight.position == std::vector<double>{0, 0, 0}) flight.position[2] = info.bbox_max[2] - info.bbox_min[2];
+  return flight;
+}
+
+// The box the camera frames: the model where it is first drawn (every body, in flight).
+void startBox(const ViewSession& session, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+  std::vector<float> x;
+  session.positions(x);
+  lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+  for (size_t v = 0; v < x.size() / 3; ++v)
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], double(x[3 * v + a])), hi[a] = std::max(hi[a], double(x[3 * v + a]));
+  if (session.flight()) lo[2] -= hi[2] - lo[2];  // and the ground it falls to
+}
 
 // The window, its GL context and Dear ImGui, torn down in the right order.
 class Window {
@@ -107,10 +130,14 @@ void saveScreenshot(const std::string& path, int width, int height) {
 class Viewer {
 public:
   Viewer(const ViewOptions& o, const RuntimeModel& model)
-      : o_(o), model_(model), session_(model, o.settings), triangles_(model.triangles()),
-        camera_(OrbitCamera::framing(Eigen::Vector3d(model.info().bbox_min), Eigen::Vector3d(model.info().bbox_max),
-                                     double(o.size[0]) / o.size[1])),
+      : o_(o), model_(model), session_(model, o.settings, withViewerDefaults(o.flight, model.info())),
         size_((Eigen::Vector3d(model.info().bbox_max) - Eigen::Vector3d(model.info().bbox_min)).norm()) {
+    Eigen::Vector3d lo, hi;
+    startBox(session_, lo, hi);
+    camera_ = OrbitCamera::framing(lo, hi, double(o.size[0]) / o.size[1]);
+    if (const FlightWorld* flight = session_.flight())
+      for (int k = 0; k < flight->colliders().size(); ++k)
+        appendCollider(flight->colliders()[k], flight->colliders().surface(k), lo, hi, world_);
     edited_ = session_.settings();
     for (int i = 0; i < QV_INTEGRATOR_COUNT; ++i) integratorLabels_[i] = qv_integrator_description(qv_integrator(i));
     for (int i = 0; i < QV_ELASTICITY_COUNT; ++i) elasticityLabels_[i] = qv_elasticity_description(qv_elasticity(i));
@@ -146,7 +173,12 @@ public:
         static_cast<Viewer*>(glfwGetWindowUserPointer(w))->session_.reset();
     });
     window.startImGui();
-    SurfaceView surface(triangles_, model_.info().vertex_count);
+    SurfaceView surface(session_.triangles(), session_.bodyCount() * model_.info().vertex_count);
+    std::optional<SurfaceView> world;  // the colliders, still
+    if (!world_.triangles.empty()) {
+      world.emplace(world_.triangles, static_cast<int>(world_.positions.size() / 3));
+      world->update(world_.positions, std::vector<float>(world_.positions.size(), 0.0f));
+    }
     double last = glfwGetTime(), rateStart = last;
     long rateSteps = 0;
     for (int frame = 0; !glfwWindowShouldClose(window.get()) && (o_.frames == 0 || frame < o_.frames); ++frame) {
@@ -184,13 +216,13 @@ public:
       glClearColor(0.93f, 0.94f, 0.96f, 1);
       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
       session_.positions(positions_);
-      normals_.resize(positions_.size());
-      qv_model_surface_normals(model_.get(), positions_.data(), normals_.data());
+      session_.normals(positions_, normals_);
       surface.update(positions_, normals_);
       const Eigen::Matrix4f view = camera_.view(), projection = camera_.projection(double(fbWidth) / std::max(fbHeight, 1));
+      if (world) world->draw(view, projection, Eigen::Vector3f(0.62f, 0.6f, 0.56f), false);
       surface.draw(view, projection, Eigen::Vector3f(0.27f, 0.51f, 0.71f), smoothNormals_);
       if (session_.grabbing()) {
-        const int v = session_.grabbedVertex();
+        const int v = session_.grabbedVertex() + session_.grabbedBody() * model_.info().vertex_count;
         const Eigen::Vector3d& t = session_.grabTarget();
         surface.drawLines({positions_[3 * v], positions_[3 * v + 1], positions_[3 * v + 2], float(t.x()), float(t.y()),
                            float(t.z())},
@@ -200,9 +232,16 @@ public:
       if (o_.frames > 0 && frame + 1 == o_.frames && !o_.screenshot.empty()) saveScreenshot(o_.screenshot, fbWidth, fbHeight);
       glfwSwapBuffers(window.get());
     }
-    if (o_.frames > 0)
+    if (o_.frames > 0) {
       std::printf("quiver-view: %d frames, %ld steps of %g s, %d resets, %d grabs\n", o_.frames, session_.stepsTaken(),
                   session_.config().time_step, session_.resets(), grabs_);
+      for (int k = 0; session_.flight() && k < session_.bodyCount(); ++k) {
+        qv_rigid_state s;
+        qv_instance_get_rigid_state(session_.flight()->body(k).get(), &s);
+        std::printf("quiver-view: body %d: centre %.4f %.4f %.4f m, velocity %.4f %.4f %.4f m/s\n", k, s.position[0],
+                    s.position[1], s.position[2], s.linear_velocity[0], s.linear_velocity[1], s.linear_velocity[2]);
+      }
+    }
     return 0;
   }
 
@@ -292,7 +331,7 @@ private:
       if (ImGui::SliderFloat("mouse spring, N/m", &spring, 1e-3f * spring + 1e-9f, 1e3f * spring, "%.3g",
                              ImGuiSliderFlags_Logarithmic))
         edited_.springStiffness = spring;
-      if (ImGui::Button("reset (R)")) session_.reset();
+      if (ImGui::Button(session_.flight() ? "drop again (R)" : "reset (R)")) session_.reset();
       if (!(edited_ == session_.settings())) {
         try {
           session_.configure(edited_);
@@ -305,7 +344,7 @@ private:
       if (!settingsError_.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%s", settingsError_.c_str());
     }
 
-    if (ImGui::CollapsingHeader("Modes", ImGuiTreeNodeFlags_DefaultOpen)) {
+    if (!session_.flight() && ImGui::CollapsingHeader("Modes", ImGuiTreeNodeFlags_DefaultOpen)) {
       bool changed = ImGui::RadioButton("simulate", &modeKind_, 0);
       ImGui::SameLine();
       changed |= ImGui::RadioButton("linear modes", &modeKind_, 1);
@@ -325,7 +364,8 @@ private:
       if (changed) session_.showMode(ModeKind(modeKind_), modeIndex_, modeAmplitude_ * size_);
     }
     ImGui::Checkbox("smooth normals (the runtime's)", &smoothNormals_);
-    ImGui::TextDisabled("left-drag the model: pull it\nleft-drag around it: orbit; wheel: zoom");
+    ImGui::TextDisabled(session_.flight() ? "left-drag an object: lift, drag, let go moving: throw\nleft-drag around it: orbit; wheel: zoom"
+                                          : "left-drag the model: pull it\nleft-drag around it: orbit; wheel: zoom");
     ImGui::PopItemWidth();
     ImGui::End();
   }
@@ -338,9 +378,9 @@ private:
   const char* elasticityLabels_[QV_ELASTICITY_COUNT];
   const char* solverLabels_[QV_SOLVER_COUNT];
   std::string settingsError_;
-  std::vector<unsigned> triangles_;
   std::vector<float> positions_, normals_;
   OrbitCamera camera_;
+  TriangleSoup world_;  // the colliders' surfaces
   double size_;
   std::optional<DragScript> script_;
   bool mouseDown_ = false;
@@ -372,7 +412,11 @@ int main(int argc, char** argv) {
   app.add_option("--newton", o.settings.step.newton,
                  "Newton iterations per implicit step: the most (--solver minimize, default 8) or exactly (--solver newton)")
       ->check(CLI::Range(1, 20));
-  app.add_flag("--gravity", o.settings.gravity, "Start with gravity, 9.81 m/s^2 along -z");
+  app.add_flag("--gravity", o.settings.gravity, "Start with gravity, 9.81 m/s^2 along -z (always with --free)");
+  app.add_flag("--free", o.settings.step.freeFlight,
+               "Fly a free model (baked with no fixed vertex): it drops onto the colliders, by default a ground plane "
+               "under it as baked, from one height above it");
+  o.flight.addTo(app);
   app.add_option("--frames", o.frames, "Run this many frames (1/60 s of simulation each), then exit")
       ->check(Positive);
   app.add_option("--screenshot", o.screenshot, "With --frames: save the last frame as a PNG");
@@ -383,6 +427,13 @@ int main(int argc, char** argv) {
     if (o.size.size() != 2 || o.size[0] < 64 || o.size[1] < 64 || o.size[0] > 8192 || o.size[1] > 8192)
       throw std::runtime_error("--size must be two numbers between 64 and 8192");
     if (!o.screenshot.empty() && o.frames == 0) throw std::runtime_error("--screenshot needs --frames N");
+    const FlightSetup none;
+    if (!o.settings.step.freeFlight && (o.flight.position != none.position || o.flight.velocity != none.velocity ||
+                                        o.flight.angularVelocity != none.angularVelocity || !o.flight.colliders.empty() ||
+                                        o.flight.pile != 1))
+      throw std::runtime_error("--position, --velocity, --angular-velocity, --collider and --pile need --free");
+    if (o.settings.step.freeFlight && !o.showMode.empty()) throw std::runtime_error("--show-mode shows a model in place: not with --free");
+    if (o.settings.step.freeFlight) o.settings.gravity = true;
     const RuntimeModel model(o.model);
     Viewer viewer(o, model);
     return viewer.run();

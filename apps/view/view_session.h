@@ -1,13 +1,15 @@
 #pragma once
 // What the viewer simulates and shows, without any window or GL: the runtime instance and its
-// settings, fixed-rate stepping decoupled from the frame rate, the mouse spring, and the mode
-// browser's animation. quiver-view draws it; tests drive it directly.
+// settings (or, in free flight, the bodies it flies among their colliders), fixed-rate stepping
+// decoupled from the frame rate, the mouse spring, and the mode browser's animation. quiver-view
+// draws it; tests drive it directly.
 #include <memory>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "apps/support/flight_world.h"
 #include "apps/support/reduced_modes.h"
 #include "apps/support/runtime_model.h"
 #include "apps/support/step_settings.h"
@@ -30,15 +32,16 @@ public:
   static constexpr int kMaxStepsPerFrame = 64;  // beyond this the simulation runs slower than real time
   static constexpr double kModePeriod = 1.5;    // s per oscillation in the mode browser, whatever the frequency
 
-  ViewSession(const RuntimeModel& model, const ViewSettings& settings);
-  ViewSession(RuntimeModel&&, const ViewSettings&) = delete;  // the session keeps a reference
+  // With settings.step.freeFlight, the bodies `flight` sets up fly (FlightWorld).
+  ViewSession(const RuntimeModel& model, const ViewSettings& settings, const FlightSetup& flight = {});
+  ViewSession(RuntimeModel&&, const ViewSettings&, const FlightSetup& = {}) = delete;  // the session keeps a reference
 
   const RuntimeModel& model() const { return model_; }
   const ViewSettings& settings() const { return settings_; }
   qv_instance_config config() const { return instance_->config(); }
   // Takes new settings; a new integrator, step, damping or elasticity makes a new instance that
-  // continues from the current displacement and velocity. Throws if the runtime refuses them (the
-  // old settings stay).
+  // continues from the current displacement and velocity (in flight: the bodies start again). Throws
+  // if the runtime refuses them (the old settings stay).
   void configure(const ViewSettings& settings);
 
   // Consumes `seconds` of wall-clock time in whole steps of the time step (at most
@@ -49,23 +52,32 @@ public:
 
   // The mouse: a press on the surface grabs the vertex nearest the hit on a spring. The spring's
   // target keeps the vertex's offset from the hit point (a press held still pulls nothing) and
-  // follows the cursor ray in the plane through the hit point facing `towardViewer`.
+  // follows the cursor ray in the plane through the hit point facing `towardViewer`. In flight the
+  // spring is a force on the grabbed body each step, damped as a whole-body critical spring (the
+  // runtime's constraints hold pinned models only): it lifts, drags and, let go while moving, throws.
   bool press(const Ray& ray, const Eigen::Vector3d& towardViewer);  // false: the ray misses the model
   void drag(const Ray& ray);
-  // The spring itself: pulls `vertex` toward `target`.
-  void grab(int vertex, const Eigen::Vector3d& target);
+  // The spring itself: pulls `vertex` of `body` toward `target`.
+  void grab(int vertex, const Eigen::Vector3d& target, int body = 0);
   void release();
   bool grabbing() const { return grabbed_ >= 0; }
   int grabbedVertex() const { return grabbed_; }
+  int grabbedBody() const { return grabbedBody_; }
   const Eigen::Vector3d& grabTarget() const { return grabTarget_; }
 
-  void reset();
-  void showMode(ModeKind kind, int index, double amplitude);  // amplitude: largest vertex displacement, m
+  void reset();  // back to rest; in flight, every body back where it started: it drops again
+  // amplitude: largest vertex displacement, m. Not in flight (throws).
+  void showMode(ModeKind kind, int index, double amplitude);
   ModeKind shownMode() const { return modeKind_; }
   const ReducedModes& modes() const { return modes_; }
 
-  // Deformed positions (3 floats per vertex): the simulation, or the shown mode.
+  // What is drawn: the bodies' surfaces (one in place, or in flight all bodies one after the other),
+  // their deformed positions (3 floats per vertex: the simulation, or the shown mode) and normals.
+  int bodyCount() const { return flight_ ? flight_->bodyCount() : 1; }
+  const FlightWorld* flight() const { return flight_.get(); }
+  const std::vector<unsigned>& triangles() const { return triangles_; }
   void positions(std::vector<float>& out) const;
+  void normals(const std::vector<float>& positions, std::vector<float>& out) const;
   struct Energies {
     double kinetic, elastic;  // J
   };
@@ -77,14 +89,26 @@ public:
 
 private:
   void applyLoads();
+  void startFlight();
+  void pullGrabbedBody();  // in flight: this step's spring force
+
+  // In flight, the mouse spring on a whole body: its stiffness (within the explicit step's limit)
+  // and critical damping.
+  struct FlightSpring {
+    double stiffness, damping;
+  };
+  FlightSpring flightSpring() const;
 
   const RuntimeModel& model_;
   ViewSettings settings_;
   std::unique_ptr<RuntimeInstance> instance_;
   ReducedModes modes_;
+  FlightSetup flightSetup_;
+  std::unique_ptr<FlightWorld> flight_;  // in flight; body 0 is instance_
+  std::vector<unsigned> triangles_;
   double accumulator_ = 0;
   bool behind_ = false;
-  int grabbed_ = -1;
+  int grabbed_ = -1, grabbedBody_ = 0;
   Eigen::Vector3d grabTarget_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d dragPoint_, dragNormal_, dragOffset_;  // the press: plane point and normal, vertex - hit
   long steps_ = 0;

@@ -12,6 +12,7 @@ import numpy as np
 
 VIEW = os.environ["QUIVER_VIEW"]
 MODEL = os.environ["QUIVER_MODEL"]
+FREE_MODEL = os.environ["QUIVER_FREE_MODEL"]
 XVFB_RUN = shutil.which("xvfb-run")
 SIZE = "640,400"
 
@@ -38,8 +39,8 @@ class QuiverView(unittest.TestCase):
     def tearDownClass(cls):
         cls.tmp.cleanup()
 
-    def view(self, *args, display=True):
-        command = [VIEW, MODEL, *([] if "--size" in args else ["--size", SIZE]), *map(str, args)]
+    def view(self, *args, display=True, model=MODEL):
+        command = [VIEW, model, *([] if "--size" in args else ["--size", SIZE]), *map(str, args)]
         if display:
             command = [XVFB_RUN, "-a", "-s", "-screen 0 1280x1024x24", *command]
         return subprocess.run(command, capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
@@ -104,6 +105,48 @@ class QuiverView(unittest.TestCase):
         mode = matplotlib.image.imread(path)[:, :, :3]
         self.assertGreater((np.abs(mode - rest).max(axis=2) > 0.1).mean(), 0.01)
 
+    @staticmethod
+    def bodies(out):
+        """The centres and velocities a bounded free-flight run prints at its end."""
+        rows = [line.split() for line in out.splitlines() if line.startswith("quiver-view: body ")]
+        return [(np.array(list(map(float, r[4:7]))), np.array(list(map(float, r[9:12])))) for r in rows]
+
+    def test_a_free_object_drops_is_lifted_and_thrown(self):
+        # Dropped from one height onto the default ground: at rest on it after a second.
+        landed_png = os.path.join(self.tmp.name, "landed.png")
+        p = self.view("--free", "--frames", 60, "--screenshot", landed_png, "--no-panel", model=FREE_MODEL)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        (centre, velocity), = self.bodies(p.stdout)
+        self.assertAlmostEqual(centre[2], 0.05, delta=0.003)  # its half height: resting on its underside
+        self.assertLess(np.linalg.norm(velocity), 0.01)
+        # Find it on the screen, press on it, pull the cursor up, swing it sideways and let go.
+        import matplotlib.image
+        image = matplotlib.image.imread(landed_png)[:, :, :3]
+        blue = image[:, :, 2] - image[:, :, 0] > 0.2
+        rows, columns = np.nonzero(blue)
+        x, y = columns.mean() / image.shape[1], rows.mean() / image.shape[0]
+        script = os.path.join(self.tmp.name, "throw.txt")
+        with open(script, "w") as f:
+            f.write(f"61 press {x:.4f} {y:.4f}\n100 move {x:.4f} {y - 0.25:.4f}\n110 move {x + 0.25:.4f} {y - 0.25:.4f}\n"
+                    f"111 release\n")
+        p = self.view("--free", "--frames", 100, "--no-panel", "--drag-script", script, model=FREE_MODEL)
+        self.assertIn("1 grabs", p.stdout)
+        (held, _), = self.bodies(p.stdout)
+        self.assertGreater(held[2], 0.1, "lifted off the ground")
+        p = self.view("--free", "--frames", 112, "--no-panel", "--drag-script", script, model=FREE_MODEL)
+        (_, thrown), = self.bodies(p.stdout)
+        self.assertGreater(np.linalg.norm(thrown[:2]), 0.3, "let go while moving: thrown")
+        p = self.view("--free", "--frames", 240, "--no-panel", "--drag-script", script, model=FREE_MODEL)
+        (end, _), = self.bodies(p.stdout)
+        print(f"landed at {centre}, held at {held}, thrown at {thrown} m/s, came down at {end}")
+        self.assertGreater(np.linalg.norm(end[:2] - centre[:2]), 0.1, "it flew somewhere else")
+        self.assertIn("0 resets", p.stdout)
+        # A pile of 8 is drawn and rests.
+        p = self.view("--free", "--pile", 8, "--frames", 150, "--no-panel", model=FREE_MODEL)
+        piled = self.bodies(p.stdout)
+        self.assertEqual(len(piled), 8)
+        self.assertLess(max(np.linalg.norm(v) for _, v in piled), 0.01)
+
     def test_bad_input_is_refused_without_a_screenshot(self):
         bad = os.path.join(self.tmp.name, "bad.txt")
         with open(bad, "w") as f:
@@ -112,7 +155,8 @@ class QuiverView(unittest.TestCase):
         for args, message in ((["--drag-script", bad], "bad.txt:2: frame 5 comes before"),
                               (["--drag-script", os.path.join(self.tmp.name, "none.txt")], "none.txt"),
                               (["--show-mode", "linear:99"], "--show-mode linear:99"),
-                              (["--show-mode", "sideways:1"], "expected linear:N or basis:N")):
+                              (["--show-mode", "sideways:1"], "expected linear:N or basis:N"),
+                              (["--pile", 3], "need --free"), (["--free"], "was baked with fixed vertices")):
             with self.subTest(args=args):
                 p = self.view("--frames", 5, "--screenshot", shot, *args)
                 self.assertEqual(p.returncode, 1, p.stderr)

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include <Eigen/Dense>
 
@@ -173,6 +174,91 @@ TEST_F(ViewSessionTest, ModesAreEigenvectorsOfTheReducedStiffnessShownAtTheirAmp
   EXPECT_THROW(session.showMode(ModeKind::BasisVector, info.r, amplitude), std::out_of_range);
   session.showMode(ModeKind::None, 0, 0);
   EXPECT_EQ(session.advance(h()), 1);
+}
+
+// The free beam (fixture test_model: 0.6 x 0.1 x 0.1 m, baked with no fixed vertex) dropped from
+// 0.2 m onto a ground plane.
+class FreeViewSessionTest : public ::testing::Test {
+protected:
+  RuntimeModel model{QUIVER_FREE_MODEL};
+  static ViewSettings flying() {
+    ViewSettings s;
+    s.step.freeFlight = true;
+    s.step.alpha = 5;
+    s.gravity = true;
+    return s;
+  }
+  static FlightSetup dropped(int pile = 1) {
+    FlightSetup f;
+    f.position = {0, 0, 0.2};
+    f.colliders = {"plane:0,0,1,0"};
+    f.pile = pile;
+    return f;
+  }
+  static qv_rigid_state frame(const ViewSession& session, int body = 0) {
+    qv_rigid_state s;
+    qv_instance_get_rigid_state(session.flight()->body(body).get(), &s);
+    return s;
+  }
+  static void run(ViewSession& session, double seconds) {
+    for (int frame = 0; frame < std::lround(60 * seconds); ++frame) session.advance(1.0 / 60);
+  }
+};
+
+TEST_F(FreeViewSessionTest, ItDropsLiftsOnTheSpringAndFliesWhereItIsThrown) {
+  ViewSession session(model, flying(), dropped());
+  run(session, 1.5);
+  EXPECT_NEAR(frame(session).position[2], 0.05, 3e-3) << "landed on its underside";
+  // Press straight down on the top face at its middle, then pull the target up in the vertical
+  // plane y = 0.05 (the plane faces the viewer at -y).
+  ASSERT_TRUE(session.press(Ray{{0.3, 0.05, 1}, {0, 0, -1}}, {0, -1, 0}));
+  const auto cursor = [](double x, double z) { return Ray{{x, -1, z}, {0, 1, 0}}; };
+  for (int k = 1; k <= 30; ++k) {
+    session.drag(cursor(0.3, 0.1 + 0.3 * k / 30));
+    session.advance(1.0 / 60);
+  }
+  run(session, 1);
+  const qv_rigid_state held = frame(session);
+  std::printf("held at z = %.3f m by a vertex targeted at 0.4 m\n", held.position[2]);
+  EXPECT_GT(held.position[2], 0.25) << "lifted off the ground";
+  // Swing the cursor 0.4 m along x in 1/6 s (2.4 m/s) and let go.
+  for (int k = 1; k <= 10; ++k) {
+    session.drag(cursor(0.3 + 0.04 * k, 0.4));
+    session.advance(1.0 / 60);
+  }
+  session.release();
+  const qv_rigid_state thrown = frame(session);
+  std::printf("let go at %.2f m/s along x\n", thrown.linear_velocity[0]);
+  EXPECT_GT(thrown.linear_velocity[0], 0.5);
+  run(session, 2);
+  const qv_rigid_state landed = frame(session);
+  std::printf("landed at x = %.3f m (thrown from %.3f m)\n", landed.position[0], thrown.position[0]);
+  EXPECT_GT(landed.position[0], thrown.position[0] + 0.1);
+  EXPECT_NEAR(landed.position[2], 0.05, 0.01);
+  EXPECT_EQ(session.resets(), 0);
+  // Drop again: back where it started, falling.
+  session.reset();
+  EXPECT_NEAR(frame(session).position[2], 0.25, 1e-12);
+  EXPECT_THROW(session.showMode(ModeKind::LinearMode, 0, 0.01), std::logic_error);
+}
+
+TEST_F(FreeViewSessionTest, APileIsDrawnAsAllItsBodiesAndComesToRest) {
+  ViewSession session(model, flying(), dropped(8));
+  ASSERT_EQ(session.bodyCount(), 8);
+  const size_t n = static_cast<size_t>(model.info().vertex_count);
+  std::vector<float> x, normals;
+  session.positions(x);
+  session.normals(x, normals);
+  EXPECT_EQ(x.size(), 3 * 8 * n);
+  EXPECT_EQ(normals.size(), x.size());
+  EXPECT_EQ(session.triangles().size(), 8 * model.triangles().size());
+  for (unsigned index : session.triangles()) ASSERT_LT(index, 8 * n);
+  run(session, 3);
+  for (int k = 0; k < 8; ++k) {
+    const qv_rigid_state s = frame(session, k);
+    EXPECT_LT(std::hypot(s.linear_velocity[0], s.linear_velocity[1], s.linear_velocity[2]), 1e-3) << "body " << k;
+    EXPECT_GT(s.position[2], 0.04) << "body " << k;
+  }
 }
 
 } // namespace
