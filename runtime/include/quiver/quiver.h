@@ -16,7 +16,7 @@ extern "C" {
 #endif
 
 #define QV_VERSION_MAJOR 0
-#define QV_VERSION_MINOR 3
+#define QV_VERSION_MINOR 4
 #define QV_VERSION_PATCH 0
 #define QV_VERSION_NUMBER (QV_VERSION_MAJOR * 10000 + QV_VERSION_MINOR * 100 + QV_VERSION_PATCH)
 
@@ -273,7 +273,7 @@ QV_API qv_result qv_instance_set_rigid_state(qv_instance* instance, const qv_rig
    vertices: each step, velocity-level impulses on its frame (restitution, Coulomb friction; stiff at any time
    step), found and solved on the rigid shape it carries, and the same forces on its deformation. At rest a
    vertex sinks by a slop of 1e-3 of the model's diagonal, the contacts' slight softness and its own
-   deformation: 2.2 mm (3.6e-3 of the diagonal) on tests/runtime/contact_test.cpp's soft bar at 1/60 s.
+   deformation: 1.5 mm (2.4e-3 of the diagonal) on tests/runtime/contact_test.cpp's soft bar at 1/60 s.
    Nothing moving faster than the step can see tunnels: a vertex is caught while its frame's (and the
    collider's) motion can reach the collider within the step; a collider thinner than the spacing of the
    object's surface vertices can pass between them. */
