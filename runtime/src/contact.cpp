@@ -180,12 +180,13 @@ double relativeSpeed(const ContactBody& b, const double velocity[3]) {
 void findColliderContacts(const ContactBody* bodies, int i, const qv_collider* colliders, int count, double h,
                           ContactList& list) {
   const qv_instance& s = *bodies[i].instance;
-  for (int k = 0; k < count; ++k) {
-    const qv_collider& col = colliders[k];
-    for (int n = 0; n < s.surfaceCount; ++n) {
-      const int v = s.surfaceVertices[n];
-      double p[3], u[3], depth, normal[3];
-      worldVertex(s, v, false, p);
+  for (int n = 0; n < s.surfaceCount && count; ++n) {
+    const int v = s.surfaceVertices[n];
+    double p[3];
+    worldVertex(s, v, false, p);
+    for (int k = 0; k < count; ++k) {
+      const qv_collider& col = colliders[k];
+      double u[3], depth, normal[3];
       surfaceVelocity(col, p, u);
       const double margin = s.contactSlop + 2 * h * relativeSpeed(bodies[i], u);
       if (!colliderDistance(col, p, margin, depth, normal) || depth > margin) continue;
