@@ -150,7 +150,7 @@ bool bodyDistance(const qv_instance& s, const double p[3], double reach, double&
   return true;
 }
 
-// Keeps `c` when there is room, or in place of the shallowest contact when it is deeper.
+// Where a contact `depth` deep goes: a free slot, or the shallowest one when it is deeper; null when it is not kept.
 Contact* admit(ContactList& list, double depth) {
   if (list.count < list.capacity) return &list.contacts[list.count++];
   if (!list.capacity) return nullptr;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "dropped_bar.h"
+#include "tests/support/box_surface.h"
 #include "tests/support/make_collider.h"
 
 namespace quiver {
@@ -22,12 +23,9 @@ constexpr double kG = QV_STANDARD_GRAVITY;
 struct SlabMesh {
   qv_triangle_mesh* mesh = nullptr;
   SlabMesh() {
-    std::vector<double> x;
-    for (int k = 0; k < 8; ++k) x.insert(x.end(), {k & 1 ? 3.0 : -3.0, k & 2 ? 1.0 : -1.0, k & 4 ? 0.5 : -0.5});
-    const int quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
-    std::vector<int> t;
-    for (const auto& q : quads) t.insert(t.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
-    EXPECT_EQ(qv_triangle_mesh_create(x.data(), 8, t.data(), 12, nullptr, &mesh, nullptr, 0), QV_OK);
+    const double half[3] = {3, 1, 0.5};
+    const test::BoxSurface s = test::boxSurface(half);
+    EXPECT_EQ(qv_triangle_mesh_create(s.positions.data(), 8, s.triangles.data(), 12, nullptr, &mesh, nullptr, 0), QV_OK);
   }
   ~SlabMesh() { qv_triangle_mesh_destroy(mesh); }
 };

@@ -7,12 +7,14 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
 
 #include "runtime/src/triangle_mesh.h"
 #include "quiver/quiver.h"
+#include "tests/support/box_surface.h"
 
 namespace quiver {
 namespace {
@@ -24,12 +26,8 @@ struct Surface {
 
 // The cube [-1, 1]^3 scaled by `half`, two triangles a face, outward.
 Surface cube(const double half[3]) {
-  Surface s;
-  for (int k = 0; k < 8; ++k)
-    for (int a = 0; a < 3; ++a) s.positions.push_back(((k >> a) & 1 ? 1 : -1) * half[a]);
-  const int quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
-  for (const auto& q : quads) s.triangles.insert(s.triangles.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
-  return s;
+  test::BoxSurface box = test::boxSurface(half);
+  return Surface{std::move(box.positions), std::move(box.triangles)};
 }
 
 // A UV sphere whose radius at direction d is radius(d): rings x segments, poles shared.
