@@ -150,14 +150,78 @@ bool bodyDistance(const qv_instance& s, const double p[3], double reach, double&
   return true;
 }
 
-// Where a contact `depth` deep goes: a free slot, or the shallowest one when it is deeper; null when it is not kept.
-Contact* admit(ContactList& list, double depth) {
-  if (list.count < list.capacity) return &list.contacts[list.count++];
-  if (!list.capacity) return nullptr;
-  int slot = 0;
-  for (int j = 1; j < list.count; ++j)
-    if (list.contacts[j].depth > list.contacts[slot].depth) slot = j;
-  return list.contacts[slot].depth > depth ? &list.contacts[slot] : nullptr;
+// Body b's pair with a collider or another body; in the first pass a new one when it has none
+// yet (null when the table is full: its candidates then compete by depth alone).
+ContactPair* findPair(ContactList& list, ContactBody& b, int body, int other, int collider) {
+  for (int p = b.firstPair; p < b.pairEnd; ++p)
+    if (list.pairs[p].other == other && list.pairs[p].collider == collider) return &list.pairs[p];
+  if (list.reducing || list.pairCount == list.capacity) return nullptr;
+  ContactPair& pair = list.pairs[list.pairCount++];
+  pair = ContactPair{};
+  pair.body = body, pair.other = other, pair.collider = collider;
+  b.pairEnd = list.pairCount;
+  return &pair;
+}
+
+// Where a candidate contact goes, with who touches what where filled in; null when it is not kept.
+// Touching candidates (within the slop) come before speculative ones (farther, within the step's
+// reach), and the deeper first: a full list gives up its shallowest speculative contact, then its
+// shallowest. The first pass counts the touching by pair and level; when more touch than fit, the
+// second keeps each pair's down to its minLevel (keepLevels()), spread over its patch, not the
+// deepest: those sat on one side of a resting face, then on the other as it tilted, and it rocked
+// forever. (Keeping each pair's deepest as well made it rock again: that vertex switched ends.)
+Contact* admit(ContactList& list, ContactBody& b, int body, int other, int collider, int n, double depth) {
+  const bool speculative = depth > b.instance->contactSlop;
+  if (!speculative) {
+    const int level = b.instance->surfaceLevels[n];
+    ContactPair* pair = findPair(list, b, body, other, collider);
+    if (!list.reducing) {
+      ++list.touching;
+      if (pair) ++pair->count[level];
+    } else if (pair && level < pair->minLevel) {
+      return nullptr;
+    }
+  }
+  const auto worse = [](const Contact& x, bool xSpeculative, double xDepth) {
+    return x.speculative != xSpeculative ? x.speculative : x.depth > xDepth;
+  };
+  Contact* slot = nullptr;
+  if (list.count < list.capacity) {
+    slot = &list.contacts[list.count++];
+  } else if (list.capacity) {
+    slot = &list.contacts[0];
+    for (int j = 1; j < list.count; ++j)
+      if (worse(list.contacts[j], slot->speculative, slot->depth)) slot = &list.contacts[j];
+    if (!worse(*slot, speculative, depth)) return nullptr;
+  }
+  if (slot) {
+    *slot = Contact{};
+    slot->body = body, slot->other = other, slot->collider = collider, slot->depth = depth, slot->speculative = speculative;
+    slot->vertex = b.instance->surfaceVertices[n];
+  }
+  return slot;
+}
+
+int keptOf(const ContactPair& p) {
+  int kept = 0;
+  for (int l = p.minLevel; l < kContactLevels; ++l) kept += p.count[l];
+  return kept;
+}
+
+// Levels for each pair so that its touching candidates fit: the pair that keeps the most gives up its
+// lowest level, until they fit (a patch of a few vertices keeps them all while a face of hundreds
+// thins out).
+void keepLevels(ContactList& list) {
+  int total = list.touching;  // every pair keeps all to begin with
+  while (total > list.capacity) {
+    ContactPair* richest = nullptr;
+    int most = 1;
+    for (int p = 0; p < list.pairCount; ++p)
+      if (list.pairs[p].minLevel < kContactLevels - 1 && keptOf(list.pairs[p]) > most) richest = &list.pairs[p], most = keptOf(*richest);
+    if (!richest) break;
+    ++richest->minLevel;
+    total += keptOf(*richest) - most;
+  }
 }
 
 // Contacts by who touches what where: the warm start finds last step's by it, and the solve runs
@@ -177,7 +241,7 @@ double relativeSpeed(const ContactBody& b, const double velocity[3]) {
 }
 
 // Each surface vertex of body i against every collider.
-void findColliderContacts(const ContactBody* bodies, int i, const qv_collider* colliders, int count, double h,
+void findColliderContacts(ContactBody* bodies, int i, const qv_collider* colliders, int count, double h,
                           ContactList& list) {
   const qv_instance& s = *bodies[i].instance;
   for (int n = 0; n < s.surfaceCount && count; ++n) {
@@ -190,10 +254,8 @@ void findColliderContacts(const ContactBody* bodies, int i, const qv_collider* c
       surfaceVelocity(col, p, u);
       const double margin = s.contactSlop + 2 * h * relativeSpeed(bodies[i], u);
       if (!colliderDistance(col, p, margin, depth, normal) || depth > margin) continue;
-      Contact* ct = admit(list, depth);
+      Contact* ct = admit(list, bodies[i], i, -1, k, n, depth);
       if (!ct) continue;
-      *ct = Contact{};
-      ct->body = i, ct->vertex = v, ct->collider = k, ct->depth = depth;
       ct->friction = col.friction, ct->restitution = col.restitution;
       double deformed[3], ignored[3];
       worldVertex(s, v, true, deformed);
@@ -207,7 +269,7 @@ void findColliderContacts(const ContactBody* bodies, int i, const qv_collider* c
 }
 
 // Each surface vertex of body i against body j's rest surface, when their spheres come within reach.
-void findBodyContacts(const ContactBody* bodies, int i, int j, double h, const ContactMaterial& material,
+void findBodyContacts(ContactBody* bodies, int i, int j, double h, const ContactMaterial& material,
                       ContactList& list) {
   const qv_instance &a = *bodies[i].instance, &b = *bodies[j].instance;
   if (!b.model->surfaceMesh) return;
@@ -223,10 +285,9 @@ void findBodyContacts(const ContactBody* bodies, int i, int j, double h, const C
     int otherVertex = 0;
     worldVertex(a, v, false, p);
     if (!bodyDistance(b, p, margin, depth, normal, &otherVertex) || depth > margin) continue;
-    Contact* ct = admit(list, depth);
+    Contact* ct = admit(list, bodies[i], i, j, -1, n, depth);
     if (!ct) continue;
-    *ct = Contact{};
-    ct->body = i, ct->other = j, ct->vertex = v, ct->otherVertex = otherVertex, ct->depth = depth;
+    ct->otherVertex = otherVertex;
     ct->friction = material.friction, ct->restitution = material.restitution;
     // Reported: the deformed vertex against the other's surface, moved where the other's nearest
     // vertex moved along the normal (both deform).
@@ -316,10 +377,22 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
   // rigid shape: the deformation takes the forces but does not move the contacts (taking its
   // vertices made the loads on q and the contacts chase each other: a resting bar fluttered, bent
   // 1.5 cm, its contacts hopping between its ends and its middle every few steps).
-  for (int i = 0; i < bodyCount; ++i) {
-    findColliderContacts(bodies, i, colliders, colliderCount, h, list);
-    for (int j = 0; j < bodyCount; ++j)
-      if (j != i) findBodyContacts(bodies, i, j, h, material, list);
+  const auto find = [&] {
+    for (int i = 0; i < bodyCount; ++i) {
+      if (!list.reducing) bodies[i].firstPair = bodies[i].pairEnd = list.pairCount;
+      findColliderContacts(bodies, i, colliders, colliderCount, h, list);
+      for (int j = 0; j < bodyCount; ++j)
+        if (j != i) findBodyContacts(bodies, i, j, h, material, list);
+    }
+  };
+  list.pairCount = list.touching = 0;
+  find();
+  if (list.touching > list.capacity) {  // again, keeping a spread subset of each pair's
+    keepLevels(list);
+    list.count = 0;
+    list.reducing = true;
+    find();
+    list.reducing = false;
   }
   if (!list.count) return;
   std::sort(list.contacts, list.contacts + list.count, keyBefore);

@@ -7,7 +7,9 @@
 // Each step, between the frames' velocity updates and their moves (rigid_frame.h):
 // - every surface vertex within reach of a collider or another object (its signed distance below
 //   what the two can cover relative to each other in the step, a speculative margin) is a contact,
-//   up to a capacity (the deepest kept);
+//   up to a capacity: when more are found, each pair (a body against a collider or another body)
+//   keeps its vertices down to a level (contact_points.h), a subset spread over its patch; the
+//   pairs with the most give up levels first;
 // - sequential impulses (24 sweeps) on the frames' velocities and angular momenta: a normal impulse
 //   >= 0 that stops the approach where the surfaces meet (so nothing tunnels while it is seen) and
 //   pushes out what penetrates beyond a slop, slightly soft so that a resting face shares its weight
@@ -31,7 +33,7 @@ struct ContactBody {
   qv_instance* instance = nullptr;
   double velocity[3] = {}, angularMomentum[3] = {};
   double omega[3] = {};  // the world angular velocity before the solve
-  double reach = 0;      // m: how far its surface can move within the step, beyond its rest radius
+  int firstPair = 0, pairEnd = 0;  // its pairs in the contact list
 };
 
 // Friction and restitution between two instances (a collider brings its own).

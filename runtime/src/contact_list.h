@@ -1,7 +1,10 @@
 #pragma once
 // The contacts of a step (contact.h), and the last step's, kept to warm-start the next: a contact
 // seen again (same vertex against the same collider or body) starts from the impulse it ended with,
-// so that a stack's impulses converge over steps rather than restarting from zero each step.
+// so that a stack's impulses converge over steps rather than restarting from zero each step. And
+// the step's pairs (a body against a collider or another body), whose candidates it counts by level
+// (contact_points.h) to keep a spread subset of each when they do not all fit.
+#include "contact_points.h"
 
 namespace quiver::rt {
 
@@ -15,6 +18,7 @@ struct Contact {
   double arm[3] = {}, otherArm[3] = {};  // point - x of body and of other
   double surfaceVelocity[3] = {};        // a kinematic collider's at the point
   double depth = 0;          // signed distance of the rigid shape's vertex (negative: penetrating)
+  bool speculative = false;  // depth beyond the slop: not touching yet
   double deformedDepth = 0;  // of the deformed vertex, reported
   double target = 0;         // the relative normal velocity the impulse aims at
   double bounce = 0;         // restitution x the approach speed: the target once the contact holds
@@ -27,12 +31,23 @@ struct Contact {
   double friction = 0, restitution = 0;
 };
 
+// One body's candidate contacts with one collider or one other body in a step.
+struct ContactPair {
+  int body = 0, other = -1, collider = -1;
+  int count[kContactLevels] = {};  // candidates by level
+  int minLevel = 0;  // kept: candidates of this level and above
+};
+
 // Where a solve puts its contacts: `contacts` this step's, `previous` the last step's (sorted by
-// key); two arrays of `capacity` that trade places each step.
+// key); two arrays of `capacity` that trade places each step; `pairs`, `capacity` more.
 struct ContactList {
   Contact* contacts = nullptr;
   Contact* previous = nullptr;
+  ContactPair* pairs = nullptr;
   int count = 0, previousCount = 0, capacity = 0;
+  int pairCount = 0;
+  int touching = 0;       // candidates within the slop this step, kept or not
+  bool reducing = false;  // finding again, each pair down to its minLevel
 
   void clear() { count = previousCount = 0; }
 };

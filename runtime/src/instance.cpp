@@ -75,16 +75,15 @@ qv_instance* constructInstance(const qv_model& model, const qv_instance_config& 
     std::memcpy(s->frame.homePosition, model.rigidBody, sizeof s->frame.homePosition);  // as baked
     s->loads.frame = &s->frame;
     s->loads.model = &model;
-    // The surface's vertices touch the world; a stored triangle marks its corners.
-    for (int v = 0; v < model.info.vertex_count; ++v) s->surfaceVertices[v] = 0;
-    for (size_t k = 0; k < 3 * static_cast<size_t>(model.info.triangle_count); ++k) s->surfaceVertices[model.triangles[k]] = 1;
-    for (int v = 0; v < model.info.vertex_count; ++v)
-      if (s->surfaceVertices[v]) {
-        s->surfaceVertices[s->surfaceCount++] = v;
-        double r2 = 0;
-        for (int a = 0; a < 3; ++a) r2 += std::pow(model.rest[3 * v + a] - model.rigidBody[a], 2);
-        s->surfaceRadius = std::fmax(s->surfaceRadius, std::sqrt(r2));
-      }
+    // The surface's vertices touch the world (contact_points.h).
+    s->surfaceVertices = model.contactVertices;
+    s->surfaceLevels = model.contactLevels;
+    s->surfaceCount = model.contactCount;
+    for (int k = 0; k < s->surfaceCount; ++k) {
+      double r2 = 0;
+      for (int a = 0; a < 3; ++a) r2 += std::pow(model.rest[3 * s->surfaceVertices[k] + a] - model.rigidBody[a], 2);
+      s->surfaceRadius = std::fmax(s->surfaceRadius, std::sqrt(r2));
+    }
     double d2 = 0;
     for (int a = 0; a < 3; ++a) d2 += std::pow(model.info.bbox_max[a] - model.info.bbox_min[a], 2);
     s->contactSlop = 1e-3 * std::sqrt(d2);
@@ -122,8 +121,8 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
     frame.attach(c.take<double>(quiver::rt::RigidFrame::scratchDoubles(r)), r);
     contacts.contacts = c.take<quiver::rt::Contact>(static_cast<size_t>(config.max_contacts));
     contacts.previous = c.take<quiver::rt::Contact>(static_cast<size_t>(config.max_contacts));
+    contacts.pairs = c.take<quiver::rt::ContactPair>(static_cast<size_t>(config.max_contacts));
     contacts.capacity = config.max_contacts;
-    surfaceVertices = c.take<int>(static_cast<size_t>(model->info.vertex_count));
   }
 }
 

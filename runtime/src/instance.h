@@ -62,7 +62,8 @@ struct qv_instance {
   const qv_collider* colliders = nullptr;  // the caller's (qv_instance_set_colliders)
   int colliderCount = 0;
   quiver::rt::ContactList contacts;  // the last step's and the one before, config.max_contacts each (contact.h)
-  int* surfaceVertices = nullptr;  // in flight: the contact points
+  const int* surfaceVertices = nullptr;  // in flight: the contact points, the model's (contact_points.h)
+  const unsigned char* surfaceLevels = nullptr;
   int surfaceCount = 0;
   double surfaceRadius = 0;        // m: the farthest surface vertex from the centre of mass, at rest
   double contactSlop = 0;          // m: penetration left alone

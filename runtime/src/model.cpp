@@ -8,6 +8,7 @@
 #include <string>
 
 #include "block_carver.h"
+#include "contact_points.h"
 #include "formats/model/qvr.h"
 #include "triangle_mesh.h"
 
@@ -64,6 +65,8 @@ size_t layOut(const ModelView& view, bool single, const qv_allocator& allocator,
   double* rotations = view.rotations ? c.take<double>(3 * n * r) : nullptr;
   double* rigidBody = view.rigidBody ? c.take<double>(qvr::rigidBodySize(r)) : nullptr;
   double* restStiffness = c.take<double>(r * r);
+  int* contactVertices = view.rigidBody ? c.take<int>(n) : nullptr;
+  unsigned char* contactLevels = view.rigidBody ? c.take<unsigned char>(n) : nullptr;
   // Used once, while loading: a few kilobytes, so that a model stays one allocation.
   double* scratch = c.take<double>(2 * r + ReducedPolynomial::scratchSize(in.r));
   if (!block) return c.size();
@@ -92,6 +95,10 @@ size_t layOut(const ModelView& view, bool single, const qv_allocator& allocator,
   m->rigidBody = view.rigidBody ? copy(rigidBody, view.rigidBody, qvr::rigidBodySize(r)) : nullptr;
   const double lambdaMax = restStiffnessAndLargestEigenvalue(*m, restStiffness, scratch);
   m->restStiffness = restStiffness;
+  m->contactVertices = contactVertices;
+  m->contactLevels = contactLevels;
+  m->contactCount = view.rigidBody ? orderContactPoints(rest, int(n), m->triangles, int(in.triangleCount), allocator,
+                                                        contactVertices, contactLevels) : 0;
   m->stableStep = lambdaMax > 0 ? 2.0 / std::sqrt(lambdaMax) : INFINITY;
   return c.size();
 }
@@ -116,6 +123,10 @@ qv_result loadModel(const void* data, size_t size, const qv_model_config& config
   if (!block) return QV_ERROR_OUT_OF_MEMORY;
   layOut(view, single, allocator, block);
   qv_model* model = reinterpret_cast<qv_model*>(block);
+  if (model->contactCount < 0) {
+    destroyModel(model);
+    return QV_ERROR_OUT_OF_MEMORY;
+  }
   if (model->rigidBody && model->info.triangle_count) {
     // Its surface for other instances to touch; an open surface only forgoes that.
     qv_triangle_mesh* surface = nullptr;

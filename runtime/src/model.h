@@ -25,6 +25,11 @@ struct qv_model {
   // A free model's rest surface, which other instances touch in a world (contact.h); null when the
   // model is pinned or its surface is not closed.
   const qv_triangle_mesh* surfaceMesh;
+  // A free model's surface vertices, the points that touch, spread evenly level by level
+  // (contact_points.h); null when pinned.
+  const int* contactVertices;
+  const unsigned char* contactLevels;
+  int contactCount;
 
   double basisEntry(size_t row, size_t j) const {
     const size_t r = static_cast<size_t>(info.r);

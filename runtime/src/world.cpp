@@ -17,6 +17,7 @@ size_t layOut(const qv_world_config& config, char* block, qv_world** world) {
   ContactBody* bodies = c.take<ContactBody>(static_cast<size_t>(config.max_instances));
   Contact* contacts = c.take<Contact>(static_cast<size_t>(config.max_contacts));
   Contact* previous = c.take<Contact>(static_cast<size_t>(config.max_contacts));
+  ContactPair* pairs = c.take<ContactPair>(static_cast<size_t>(config.max_contacts));
   if (block) {
     w = new (w) qv_world{};
     w->config = config;
@@ -24,6 +25,7 @@ size_t layOut(const qv_world_config& config, char* block, qv_world** world) {
     w->bodies = new (bodies) ContactBody[config.max_instances];
     w->contacts.contacts = contacts;
     w->contacts.previous = previous;
+    w->contacts.pairs = pairs;
     w->contacts.capacity = config.max_contacts;
     *world = w;
   }

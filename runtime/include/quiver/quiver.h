@@ -183,7 +183,8 @@ typedef struct qv_instance_config {
                                 the instance; default 100 x the model's diagonal */
   qv_elasticity elasticity;  /* default QV_ELASTICITY_STVK */
   int free_flight;           /* 1: the object flies in a moving frame (qv_rigid_state; needs has_rigid_body); default 0 */
-  int max_contacts;          /* in flight: contact points solved per step, 0..4096 (the deepest kept); default 64 */
+  int max_contacts;          /* in flight: contact points solved per step, 0..4096; default 64. When more touch, each
+                                touching patch keeps a subset spread over it (docs/architecture.md, Contact) */
 } qv_instance_config;
 
 /* Defaults for `model` (pass NULL for model-independent defaults). */
@@ -340,7 +341,7 @@ QV_API int qv_instance_contacts(const qv_instance* instance, qv_contact* contact
 typedef struct qv_world qv_world;
 typedef struct qv_world_config {
   int max_instances;  /* default 64 */
-  int max_contacts;   /* all the world's contacts in a step (the deepest kept); default 4096 */
+  int max_contacts;   /* all the world's contacts in a step (more: each patch keeps a spread subset); default 4096 */
   double friction;    /* between instances: Coulomb mu, default 0.5 */
   double restitution; /* between instances: 0..1, default 0 */
 } qv_world_config;
