@@ -50,8 +50,8 @@ int RuntimeTarget::step(int& newton) {
   return status == QV_STEP_RESET ? 1 : 0;
 }
 
-void RuntimeTarget::displacement(std::vector<double>& u) const {
-  const std::vector<float> p = instance_.positions();
+void RuntimeTarget::displacement(int body, std::vector<double>& u) const {
+  const std::vector<float> p = (flight_ ? flight_->body(body) : instance_).positions();
   const double* rest = qv_model_rest_positions(model_.get());
   u.resize(p.size());
   for (size_t i = 0; i < p.size(); ++i) u[i] = p[i] - rest[i];

@@ -19,7 +19,8 @@ public:
   void setSprings(const std::vector<int>& vertices, const std::vector<double>& targets, double stiffness) override;
   void clearSprings() override;
   int step(int& newtonIterations) override;
-  void displacement(std::vector<double>& u) const override;
+  int bodyCount() const override { return flight_ ? flight_->bodyCount() : 1; }
+  void displacement(int body, std::vector<double>& u) const override;
   void energies(double& kinetic, double& elastic) const override;
   double timeStep() const override { return instance_.config().time_step; }
 

@@ -31,7 +31,7 @@ public:
     newton = sim_.step();
     return 0;
   }
-  void displacement(std::vector<double>& u) const override {
+  void displacement(int, std::vector<double>& u) const override {
     const Eigen::VectorXd shown = sim_.displacement();
     u.assign(shown.data(), shown.data() + shown.size());
   }

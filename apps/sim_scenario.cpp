@@ -142,15 +142,21 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
     csv << step + 1 << "," << (step + 1) * h << "," << kinetic << "," << elastic << "," << result.stepMicros.back() << ","
         << newton << "," << status << "\n";
     if (afterStep) afterStep(step + 1);
-    if (!o.output.empty() && (step + 1) % o.every == 0) {
-      target.displacement(u);
-      PointField field{"displacement", {}};
-      for (int v = 0; v < mesh.vertexCount(); ++v) field.values.emplace_back(u[3 * v], u[3 * v + 1], u[3 * v + 2]);
-      char name[64];
-      std::snprintf(name, sizeof name, "_%05d.vtu", step + 1);
-      writeFileAtomically(o.output + name, formatVtu(mesh, {field}));
-      pvd += "<DataSet timestep=\"" + std::to_string((step + 1) * h) + "\" file=\"" + stem + name + "\"/>\n";
-    }
+    if (!o.output.empty() && (step + 1) % o.every == 0)
+      for (int body = 0; body < target.bodyCount(); ++body) {  // a pile: one part per body
+        target.displacement(body, u);
+        PointField field{"displacement", {}};
+        for (int v = 0; v < mesh.vertexCount(); ++v) field.values.emplace_back(u[3 * v], u[3 * v + 1], u[3 * v + 2]);
+        char name[64];
+        if (target.bodyCount() == 1) {
+          std::snprintf(name, sizeof name, "_%05d.vtu", step + 1);
+        } else {
+          std::snprintf(name, sizeof name, "_%05d_%d.vtu", step + 1, body);
+        }
+        writeFileAtomically(o.output + name, formatVtu(mesh, {field}));
+        pvd += "<DataSet timestep=\"" + std::to_string((step + 1) * h) + "\" part=\"" + std::to_string(body) + "\" file=\"" +
+               stem + name + "\"/>\n";
+      }
   }
   if (!o.output.empty()) {
     writeFileAtomically(o.output + ".pvd", pvd + "</Collection>\n</VTKFile>\n");

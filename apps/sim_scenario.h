@@ -28,7 +28,7 @@ struct SimOptions {
   FlightSetup flight;                   // --free (step.freeFlight): where the bodies start, what they touch
   StepSettings step;                    // integrator, elasticity, time step, Newton iterations per step
                                         // (runtime; full space: at most), Rayleigh damping
-  std::string output;                   // NAME: NAME.pvd, NAME_NNNNN.vtu, NAME.csv; "" for none
+  std::string output;                   // NAME: NAME.pvd, NAME_NNNNN.vtu (a pile: NAME_NNNNN_K.vtu, body K), NAME.csv; "" for none
   int every = 1;                        // write every k-th step
   bool json = false;                    // print one JSON summary instead of text
   std::string scenarioFile;             // --scenario: expanded before parsing (apps/support/scenario_file.h)
@@ -55,7 +55,8 @@ public:
   virtual void clearSprings() = 0;
   // Advances one step; returns a status for the CSV (0 ok) and counts Newton iterations.
   virtual int step(int& newtonIterations) = 0;
-  virtual void displacement(std::vector<double>& u) const = 0;  // 3 per vertex
+  virtual int bodyCount() const { return 1; }  // a --pile flies more
+  virtual void displacement(int body, std::vector<double>& u) const = 0;  // 3 per vertex, from the rest shape
   virtual void energies(double& kinetic, double& elastic) const = 0;
   virtual double timeStep() const = 0;
 };

@@ -133,6 +133,25 @@ class FreeFlight(unittest.TestCase):
         for x, y, _ in j["final_centers"]:
             self.assertLess(max(abs(x), abs(y)), 0.9)  # inside the walls
 
+    def test_a_pile_writes_every_body(self):
+        # -o with --pile: one part per body in each frame, each where the JSON says its centre is.
+        out = os.path.join(self.tmp.name, "pile", "three")
+        j = json.loads(run(QUIVER, "sim", self.free + ".qvr", "--free", "--gravity", "--pile", 3, "--collider", "plane:0,0,1,0",
+                           "--steps", 60, "--hold", 0, "-o", out, "--every", 30, "--json").stdout)
+        with open(out + ".pvd") as f:
+            collection = f.read()
+        for step in (30, 60):
+            for body in range(3):
+                self.assertIn(f'part="{body}" file="three_{step:05d}_{body}.vtu"', collection)
+        try:
+            import meshio
+        except ImportError:
+            self.skipTest("python3-meshio not installed")
+        for body, centre in enumerate(j["final_centers"]):
+            frame = meshio.read(f"{out}_00060_{body}.vtu")
+            # The bar's vertices are a symmetric grid: their mean is its centre of mass, up to the deformation.
+            np.testing.assert_allclose((frame.points + frame.point_data["displacement"]).mean(axis=0), centre, atol=2e-3)
+
     def test_bad_colliders_are_named(self):
         open_slab = self.write_slab("open.obj", drop_last=True)
         empty = os.path.join(self.tmp.name, "empty.obj")

@@ -44,7 +44,7 @@ struct Recorder : ScenarioTarget {
     steps.back().springs = springs;  // springs persist until cleared
     return failed ? 1 : 0;
   }
-  void displacement(std::vector<double>& u) const override { u.assign(3 * 27, 0.25); }
+  void displacement(int, std::vector<double>& u) const override { u.assign(3 * 27, 0.25); }
   void energies(double& k, double& e) const override { k = 1, e = 2; }
   double timeStep() const override { return 0.5; }
 };
@@ -129,8 +129,8 @@ TEST(Scenario, OutputFilesAndFailedStepsAreCounted) {
   EXPECT_FALSE(fs::exists(dir / "sub" / "run_00007.vtu"));
   std::ifstream pvd(dir / "sub" / "run.pvd"), csv(dir / "sub" / "run.csv");
   const std::string collection((std::istreambuf_iterator<char>(pvd)), {});
-  EXPECT_NE(collection.find("timestep=\"1.500000\" file=\"run_00003.vtu\""), std::string::npos) << collection;
-  EXPECT_NE(collection.find("timestep=\"3.000000\" file=\"run_00006.vtu\""), std::string::npos);
+  EXPECT_NE(collection.find("timestep=\"1.500000\" part=\"0\" file=\"run_00003.vtu\""), std::string::npos) << collection;
+  EXPECT_NE(collection.find("timestep=\"3.000000\" part=\"0\" file=\"run_00006.vtu\""), std::string::npos);
   std::vector<std::string> lines;
   for (std::string line; std::getline(csv, line);) lines.push_back(line);
   ASSERT_EQ(lines.size(), 8u);
