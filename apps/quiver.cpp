@@ -95,6 +95,8 @@ ordered_json describeModel(const quiver::app::RuntimeModel& model) {
   out["tets"] = mi.tet_count;
   out["surface_triangles"] = mi.triangle_count;
   out["file_vertices"] = mi.file_vertex_count;
+  out["render_vertices"] = mi.render_vertex_count;  // 0: no render mesh, the tets' surface is drawn
+  out["render_triangles"] = mi.render_triangle_count;
   out["basis_precision"] = mi.basis_precision;
   const std::string bytes = quiver::readFileBytes(model.path());
   out["sections"] = sectionSizes(bytes);

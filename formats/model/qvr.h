@@ -42,12 +42,25 @@ enum SectionType : uint32_t {
   kModalRotations = 10,  // optional (written with the optional flag, so 1.0 readers skip it)
   kFidelity = 11,        // optional, likewise: the bake's fidelity report
   kRigidBody = 12,       // optional, likewise: a free object's mass moments (common/rigid_body.h)
+  kRenderMesh = 13,      // optional, likewise: a render mesh embedded in the tets (needs TETS)
 };
-constexpr uint32_t kLastKnownType = kRigidBody;
+constexpr uint32_t kLastKnownType = kRenderMesh;
 // RIGID_BODY: f64 centre of mass c (3), second moments S0 about c (3 x 3, row-major), first
 // moments B (9 x r, row 3a + b) and second moments A of the basis (9 blocks of r x r, block
 // 3a + b, row-major): rigidBodySize(r) values.
 constexpr size_t rigidBodySize(uint64_t r) { return static_cast<size_t>(12 + 9 * r + 9 * r * r); }
+
+// RENDER_MESH: a 16-byte header (u32 vertex count V, u32 triangle count T, u32 flags: bit 0 normals,
+// bit 1 UVs; u32 zero), then f32 rest positions (3V), u32 triangles (3T), u32 each vertex's tet (V),
+// f32 its weights on that tet's four vertices (4V), f32 normals (3V, with bit 0), f32 UVs (2V, with
+// bit 1), f32 render basis rows W U (3V x r, row-major).
+constexpr uint32_t kRenderNormals = 1, kRenderUVs = 2;
+constexpr uint32_t kMaxRenderCount = 1u << 26;  // vertices or triangles
+constexpr size_t kRenderHeaderSize = 16;
+constexpr uint64_t renderMeshSize(uint64_t vertices, uint64_t triangles, uint32_t flags, uint64_t r) {
+  return kRenderHeaderSize + 4 * (3 * vertices + 3 * triangles + vertices + 4 * vertices + 3 * vertices * r +
+                                  (flags & kRenderNormals ? 3 * vertices : 0) + (flags & kRenderUVs ? 2 * vertices : 0));
+}
 
 // FIDELITY: u32 case count c (<= kMaxFidelityCases), u32 frequency count f (<= the eigenvalue
 // count), c records of kFidelityRecordSize bytes (a NUL-padded ASCII name of kFidelityNameSize
@@ -154,6 +167,16 @@ struct ModelView {
   const unsigned char* fidelityCases = nullptr;
   const double* fidelityFrequencyErrors = nullptr;
   const double* rigidBody = nullptr;        // rigidBodySize(r) values (see RIGID_BODY); null when the file has none
+  // RENDER_MESH (see above): a render mesh whose vertex i moves as sum_k renderWeights[4i + k] times the
+  // displacement of vertex k of tet renderTets[i]; counts zero when the file has none.
+  uint32_t renderVertexCount = 0, renderTriangleCount = 0;
+  const float* renderPositions = nullptr;     // 3V, at rest
+  const uint32_t* renderTriangles = nullptr;  // 3T
+  const uint32_t* renderTets = nullptr;       // V
+  const float* renderWeights = nullptr;       // 4V
+  const float* renderNormals = nullptr;       // 3V, or null
+  const float* renderUVs = nullptr;           // 2V, or null
+  const float* renderBasis = nullptr;         // 3V x r
 };
 
 // Validates the .qvr file held in `data` (the whole file, `size` bytes, 8-byte aligned as malloc,

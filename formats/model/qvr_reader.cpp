@@ -4,6 +4,7 @@
 #include "formats/model/qvr.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -22,7 +23,7 @@ static_assert(std::numeric_limits<float>::is_iec559 && sizeof(float) == 4, "floa
 std::string qvr::sectionName(uint32_t type) {
   static const char* const kNames[] = {"", "MODEL_INFO", "ENERGY_COEFFICIENTS", "BASIS", "REST_POSITIONS",
                                        "SURFACE_TRIANGLES", "VERTEX_MAP", "GRAVITY_PROJECTION", "EIGENVALUES", "TETS",
-                                       "MODAL_ROTATIONS", "FIDELITY", "RIGID_BODY"};
+                                       "MODAL_ROTATIONS", "FIDELITY", "RIGID_BODY", "RENDER_MESH"};
   static_assert(std::size(kNames) == kLastKnownType + 1, "one name for every known section type");
   return type >= 1 && type <= kLastKnownType ? kNames[type] : "section type " + std::to_string(type);
 }
@@ -180,7 +181,7 @@ private:
     }
     for (uint32_t type = kModelInfo; type <= kLastKnownType; ++type)
       if (!byType_[type] && type != kTets && type != kModalRotations && type != kFidelity &&
-          type != kRigidBody)
+          type != kRigidBody && type != kRenderMesh)
         return fail("missing required section " + sectionName(type));
     return true;
   }
@@ -328,6 +329,60 @@ private:
     return true;
   }
 
+  // RENDER_MESH: counts in range and the size they imply, triangles of distinct vertices in range,
+  // tets in range of TETS (which it needs), weights of a point in or near its tet (each in [-1, 2],
+  // summing to 1 within 1e-3), every value finite.
+  bool renderMesh(const Section& s, ModelView& view) {
+    if (s.size < kRenderHeaderSize) return failIn(s, "size " + std::to_string(s.size) + " is too small for its header");
+    const unsigned char* p = data_ + s.offset;
+    const uint32_t V = load32(p), T = load32(p + 4), flags = load32(p + 8);
+    if (V < 3 || V > kMaxRenderCount) return failIn(s, "vertex count " + std::to_string(V) + " is not in 3.." + std::to_string(kMaxRenderCount));
+    if (T < 1 || T > kMaxRenderCount) return failIn(s, "triangle count " + std::to_string(T) + " is not in 1.." + std::to_string(kMaxRenderCount));
+    if (flags > (kRenderNormals | kRenderUVs) || load32(p + 12) != 0) return failIn(s, "unknown flags or a non-zero reserved word");
+    const uint64_t expected = renderMeshSize(V, T, flags, view.info.r);
+    if (s.size != expected)
+      return failIn(s, "size " + std::to_string(s.size) + " is not the " + std::to_string(expected) + " bytes of " +
+                           std::to_string(V) + " vertices and " + std::to_string(T) + " triangles");
+    if (!view.tets) return failIn(s, "needs the TETS section, which the file does not have");
+    uint64_t at = s.offset + kRenderHeaderSize;
+    const auto floatsAt = [&](uint64_t count, const char* what, const float*& out) {
+      for (uint64_t i = 0; i < count; ++i)
+        if (!finite32(load32(data_ + at + 4 * i)))
+          return failIn(s, std::string(what) + " value " + std::to_string(i) + " (byte " + std::to_string(at + 4 * i) + ") is not finite");
+      out = reinterpret_cast<const float*>(data_ + at);
+      at += 4 * count;
+      return true;
+    };
+    const auto indicesAt = [&](uint64_t count, uint32_t group, uint32_t bound, const char* what, const uint32_t*& out) {
+      for (uint64_t i = 0; i < count; ++i) {
+        const uint32_t v = load32(data_ + at + 4 * i);
+        if (v >= bound)
+          return failIn(s, std::string(what) + " entry " + std::to_string(i) + " (byte " + std::to_string(at + 4 * i) + ") is " +
+                               std::to_string(v) + ", not below " + std::to_string(bound));
+        for (uint64_t k = i - i % group; k < i; ++k)
+          if (load32(data_ + at + 4 * k) == v) return failIn(s, std::string(what) + " entry " + std::to_string(i) + " repeats a vertex of its triangle");
+      }
+      out = reinterpret_cast<const uint32_t*>(data_ + at);
+      at += 4 * count;
+      return true;
+    };
+    ModelView m = view;
+    if (!floatsAt(3ull * V, "position", m.renderPositions) || !indicesAt(3ull * T, 3, V, "triangle", m.renderTriangles) ||
+        !indicesAt(V, 1, view.info.tetCount, "tet", m.renderTets) || !floatsAt(4ull * V, "weight", m.renderWeights))
+      return false;
+    for (uint32_t i = 0; i < V; ++i) {
+      const float* w = m.renderWeights + 4 * i;
+      if (!(std::fabs(w[0] + w[1] + w[2] + w[3] - 1) <= 1e-3) || *std::min_element(w, w + 4) < -1 || *std::max_element(w, w + 4) > 2)
+        return failIn(s, "vertex " + std::to_string(i) + "'s weights are not those of a point in or near its tet");
+    }
+    if ((flags & kRenderNormals) && !floatsAt(3ull * V, "normal", m.renderNormals)) return false;
+    if ((flags & kRenderUVs) && !floatsAt(2ull * V, "UV", m.renderUVs)) return false;
+    if (!floatsAt(3ull * V * view.info.r, "render basis", m.renderBasis)) return false;
+    m.renderVertexCount = V, m.renderTriangleCount = T;
+    view = m;
+    return true;
+  }
+
   // FIDELITY: counts in range, the size they imply, printable NUL-terminated names, values finite
   // (case values may also be NaN: not measured).
   bool fidelity(const Section& s, uint32_t eigenvalueCount, ModelView& view) {
@@ -424,9 +479,10 @@ private:
       return false;
     if (byType_[kFidelity] && !fidelity(*byType_[kFidelity], info.eigenvalueCount, view)) return false;
     if (byType_[kRigidBody] && !rigidBody(view)) return false;
-    if (!byType_[kTets]) return true;
-    return indices(*byType_[kTets], info.tetCount, 4, "4 x " + std::to_string(info.tetCount) + " tets",
-                   info.vertexCount, "vertexCount", view.tets);
+    if (byType_[kTets] && !indices(*byType_[kTets], info.tetCount, 4, "4 x " + std::to_string(info.tetCount) + " tets",
+                                   info.vertexCount, "vertexCount", view.tets))
+      return false;
+    return !byType_[kRenderMesh] || renderMesh(*byType_[kRenderMesh], view);
   }
 
   const unsigned char* data_;

@@ -37,6 +37,12 @@ Piece piece(SectionType type, const std::vector<T>& values, uint32_t flags = 0) 
   return {type, values.data(), values.size() * sizeof(T), flags};
 }
 
+// Little-endian hosts only, as the writer's memcpy of float arrays already assumes.
+void append(std::vector<unsigned char>& out, const void* data, size_t bytes) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  out.insert(out.end(), p, p + bytes);
+}
+
 size_t alignUp(size_t at) { return (at + kSectionAlignment - 1) / kSectionAlignment * kSectionAlignment; }
 
 } // namespace
@@ -93,6 +99,21 @@ std::string formatModel(const ModelContents& c) {
   if (!c.tets.empty()) pieces.push_back(piece(kTets, c.tets));
   if (!c.rotations.empty()) pieces.push_back(piece(kModalRotations, c.rotations, kOptionalSection));
   if (!c.rigidBody.empty()) pieces.push_back(piece(kRigidBody, c.rigidBody, kOptionalSection));
+  std::vector<unsigned char> render;
+  if (!c.render.positions.empty()) {
+    const ModelContents::RenderMesh& m = c.render;
+    const uint32_t header[4] = {static_cast<uint32_t>(m.positions.size() / 3), static_cast<uint32_t>(m.triangles.size() / 3),
+                                (m.normals.empty() ? 0 : kRenderNormals) | (m.uvs.empty() ? 0 : kRenderUVs), 0};
+    for (uint32_t word : header) append(render, &word, 4);
+    append(render, m.positions.data(), 4 * m.positions.size());
+    append(render, m.triangles.data(), 4 * m.triangles.size());
+    append(render, m.tets.data(), 4 * m.tets.size());
+    append(render, m.weights.data(), 4 * m.weights.size());
+    append(render, m.normals.data(), 4 * m.normals.size());
+    append(render, m.uvs.data(), 4 * m.uvs.size());
+    append(render, m.basis.data(), 4 * m.basis.size());
+    pieces.push_back({kRenderMesh, render.data(), render.size(), kOptionalSection});
+  }
   std::vector<unsigned char> fidelity;
   if (!c.fidelityCases.empty() || !c.fidelityFrequencyErrors.empty()) {
     fidelity.assign(8 + c.fidelityCases.size() * kFidelityRecordSize + 8 * c.fidelityFrequencyErrors.size(), 0);
@@ -183,6 +204,17 @@ ModelContents copyModel(const ModelView& view) {
   }
   c.fidelityFrequencyErrors.assign(view.fidelityFrequencyErrors, view.fidelityFrequencyErrors + view.fidelityFrequencyCount);
   if (view.rigidBody) c.rigidBody.assign(view.rigidBody, view.rigidBody + rigidBodySize(r));
+  const size_t V = view.renderVertexCount;
+  if (V) {
+    ModelContents::RenderMesh& m = c.render;
+    m.positions.assign(view.renderPositions, view.renderPositions + 3 * V);
+    m.triangles.assign(view.renderTriangles, view.renderTriangles + size_t{3} * view.renderTriangleCount);
+    m.tets.assign(view.renderTets, view.renderTets + V);
+    m.weights.assign(view.renderWeights, view.renderWeights + 4 * V);
+    if (view.renderNormals) m.normals.assign(view.renderNormals, view.renderNormals + 3 * V);
+    if (view.renderUVs) m.uvs.assign(view.renderUVs, view.renderUVs + 2 * V);
+    m.basis.assign(view.renderBasis, view.renderBasis + 3 * V * r);
+  }
   return c;
 }
 

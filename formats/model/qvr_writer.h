@@ -29,6 +29,15 @@ struct ModelContents {
   std::vector<FidelityCase> fidelityCases;
   std::vector<double> fidelityFrequencyErrors;
   std::vector<double> rigidBody;      // rigidBodySize(r) values (see ModelView), or empty to leave them out
+  // A render mesh embedded in the tets (see ModelView; needs tets), or no vertices to leave it out.
+  struct RenderMesh {
+    std::vector<float> positions;      // 3V
+    std::vector<uint32_t> triangles;   // 3T
+    std::vector<uint32_t> tets;        // V
+    std::vector<float> weights;        // 4V
+    std::vector<float> normals, uvs;   // 3V and 2V, or empty
+    std::vector<float> basis;          // 3V x r
+  } render;
 };
 
 // The ENERGY_COEFFICIENTS of q^T A2 q + 2 q^T A3 z + z^T A4 z (z the products q_j q_k, j <= k, in

@@ -15,6 +15,7 @@
 #include "integrators/integrator.h"
 #include "model.h"
 #include "output.h"
+#include "render_mesh.h"
 #include "triangle_mesh.h"
 #include "world.h"
 #include "quiver/quiver.h"
@@ -450,6 +451,21 @@ int qv_world_contacts(const qv_world* world, qv_contact* contacts, int capacity)
 }
 
 double qv_instance_stable_time_step(const qv_instance* s) { return s ? s->model->stableStep : 0; }
+
+const float* qv_model_render_rest_positions(const qv_model* m) { return m ? m->render.rest : nullptr; }
+const unsigned* qv_model_render_triangles(const qv_model* m) { return m ? m->render.triangles : nullptr; }
+const float* qv_model_render_normals(const qv_model* m) { return m ? m->render.normals : nullptr; }
+const float* qv_model_render_uvs(const qv_model* m) { return m ? m->render.uvs : nullptr; }
+
+size_t qv_model_render_scratch_size(const qv_model* m) {
+  return m ? m->render.scratchBytes(m->info.vertex_count, m->info.tet_count) : 0;
+}
+
+qv_result qv_instance_render(const qv_instance* s, float* positions, float* normals, void* scratch) {
+  if (!s || !positions || !scratch || !s->model->render.vertexCount) return QV_ERROR_INVALID_ARGUMENT;
+  renderOutput(*s, positions, normals, scratch);
+  return QV_OK;
+}
 
 void qv_instance_positions(const qv_instance* s, float* out) {
   if (s && out) positions(*s, out);

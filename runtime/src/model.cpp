@@ -67,6 +67,8 @@ size_t layOut(const ModelView& view, bool single, const qv_allocator& allocator,
   double* restStiffness = c.take<double>(r * r);
   int* contactVertices = view.rigidBody ? c.take<int>(n) : nullptr;
   unsigned char* contactLevels = view.rigidBody ? c.take<unsigned char>(n) : nullptr;
+  RenderMesh render;
+  render.carve(c, view);
   // Used once, while loading: a few kilobytes, so that a model stays one allocation.
   double* scratch = c.take<double>(2 * r + ReducedPolynomial::scratchSize(in.r));
   if (!block) return c.size();
@@ -78,7 +80,8 @@ size_t layOut(const ModelView& view, bool single, const qv_allocator& allocator,
                           static_cast<int>(in.eigenvalueCount), static_cast<int>(in.basisPrecision),
                           static_cast<int>(in.materialIsUniform), view.rotations ? 1 : 0, view.rigidBody ? 1 : 0, in.youngsModulus, in.poissonRatio, in.density,
                           in.totalMass, in.rayleighAlpha, in.rayleighBeta, in.timeStep,
-                          {in.bboxMin[0], in.bboxMin[1], in.bboxMin[2]}, {in.bboxMax[0], in.bboxMax[1], in.bboxMax[2]}};
+                          {in.bboxMin[0], in.bboxMin[1], in.bboxMin[2]}, {in.bboxMax[0], in.bboxMax[1], in.bboxMax[2]},
+                          static_cast<int>(view.renderVertexCount), static_cast<int>(view.renderTriangleCount)};
   m->polynomial.build(in.r, view.energy, single, polynomial);
   const auto copy = [](auto* target, const auto* source, size_t count) {
     if (count) std::memcpy(target, source, count * sizeof(*target));
@@ -95,6 +98,8 @@ size_t layOut(const ModelView& view, bool single, const qv_allocator& allocator,
   m->rigidBody = view.rigidBody ? copy(rigidBody, view.rigidBody, qvr::rigidBodySize(r)) : nullptr;
   const double lambdaMax = restStiffnessAndLargestEigenvalue(*m, restStiffness, scratch);
   m->restStiffness = restStiffness;
+  render.fill(view, rest);
+  m->render = render;
   m->contactVertices = contactVertices;
   m->contactLevels = contactLevels;
   m->contactCount = view.rigidBody ? orderContactPoints(rest, int(n), m->triangles, int(in.triangleCount), allocator,

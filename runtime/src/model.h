@@ -6,6 +6,7 @@
 
 #include "quiver/quiver.h"
 #include "reduced_polynomial.h"
+#include "render_mesh.h"
 
 struct qv_model {
   qv_allocator allocator;
@@ -25,6 +26,7 @@ struct qv_model {
   // A free model's rest surface, which other instances touch in a world (contact.h); null when the
   // model is pinned or its surface is not closed.
   const qv_triangle_mesh* surfaceMesh;
+  quiver::rt::RenderMesh render;  // no vertices when the model has none
   // A free model's surface vertices, the points that touch, spread evenly level by level
   // (contact_points.h); null when pinned.
   const int* contactVertices;

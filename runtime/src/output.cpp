@@ -20,6 +20,8 @@ void vertexDisplacement(const qv_instance& s, int v, double u[3]) {
   warping::warpDisplacement(w, d, u);
 }
 
+} // namespace
+
 // In flight, body positions (X + u) into the world: x + R (X + u - c).
 void intoWorld(const qv_instance& s, float* p, size_t count) {
   if (!s.flying()) return;
@@ -32,7 +34,27 @@ void intoWorld(const qv_instance& s, float* p, size_t count) {
   }
 }
 
-} // namespace
+void directionsIntoWorld(const qv_instance& s, float* d, size_t count) {
+  if (!s.flying()) return;
+  for (size_t k = 0; k < count; ++k) {
+    const double body[3] = {d[3 * k], d[3 * k + 1], d[3 * k + 2]};
+    double world[3];
+    s.frame.toWorldDirection(body, world);
+    for (int a = 0; a < 3; ++a) d[3 * k + a] = static_cast<float>(world[a]);
+  }
+}
+
+void simulatedDisplacements(const qv_instance& s, float* out) {
+  if (s.config.elasticity != QV_ELASTICITY_MODAL_WARPING) {
+    displacements(*s.model, s.q, out);
+    return;
+  }
+  for (int v = 0; v < s.model->info.vertex_count; ++v) {
+    double u[3];
+    vertexDisplacement(s, v, u);
+    for (int c = 0; c < 3; ++c) out[3 * v + c] = static_cast<float>(u[c]);
+  }
+}
 
 void displacements(const qv_model& m, const double* q, float* out) {
   const size_t rows = 3 * static_cast<size_t>(m.info.vertex_count), r = m.info.r;

@@ -113,6 +113,15 @@ def write_qvr_seeds():
     rigid += [0.01 * math.cos(i) for i in range(9 * r)] + [0.05 * math.sin(i) for i in range(9 * r * r)]
     free = qvr_sections(64, True) + [(12, 1, struct.pack(f"<{len(rigid)}d", *rigid))]
     open(write("qvr", "free_rigid_body.qvr"), "wb").write(qvr_file(free))
+    # A render mesh (RENDER_MESH, type 13, optional): 3 vertices in tet 0 (one outside it), one
+    # triangle, normals and UVs, the render basis (3V x r).
+    weights = [0.25, 0.25, 0.25, 0.25, 1, 0, 0, 0, -0.5, 0.5, 0.5, 0.5]
+    header = struct.pack("<4I", 3, 1, 3, 0)
+    f32 = lambda values: struct.pack(f"<{len(values)}f", *values)
+    render = header + f32([0.5, 0.0, -0.25, 0.6, 0.0, -0.25, 0.55, 0.1, -0.2]) + struct.pack("<3I", 0, 1, 2)
+    render += struct.pack("<3I", 0, 0, 0) + f32(weights) + f32([0, 0, 1] * 3) + f32([0, 0, 1, 0, 0, 1])
+    render += f32([0.01 * i for i in range(9 * r)])
+    open(write("qvr", "render_mesh.qvr"), "wb").write(qvr_file(qvr_sections(32, True) + [(13, 1, render)]))
 
 
 def main():

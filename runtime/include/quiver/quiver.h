@@ -73,6 +73,8 @@ typedef struct qv_model_info {
   double rayleigh_beta;      /* s */
   double time_step;          /* suggested, s */
   double bbox_min[3], bbox_max[3];
+  int render_vertex_count;   /* the render mesh's (qv_instance_render), 0 when the model has none */
+  int render_triangle_count;
 } qv_model_info;
 
 /* How a model is held in memory. Fill with qv_model_config_init(). */
@@ -368,6 +370,22 @@ QV_API double qv_instance_stable_time_step(const qv_instance* instance);
 QV_API void qv_instance_positions(const qv_instance* instance, float* positions);
 QV_API qv_result qv_instance_positions_of(const qv_instance* instance, const int* vertices, int count, float* positions);
 QV_API void qv_model_surface_normals(const qv_model* model, const float* positions, float* normals);
+
+/* The render mesh, for a model baked with one (qv_model_info.render_vertex_count > 0; NULL otherwise):
+   an artist's triangle mesh each of whose vertices a tet carries (formats/model/QVR.md, RENDER_MESH).
+   Its rest positions (3 floats per vertex), triangles (3 indices each, counter-clockwise seen from
+   outside), rest normals (3 floats: as baked, or area-weighted) and UVs (2 floats, NULL when it has none). */
+QV_API const float* qv_model_render_rest_positions(const qv_model* model);
+QV_API const unsigned* qv_model_render_triangles(const qv_model* model);
+QV_API const float* qv_model_render_normals(const qv_model* model);
+QV_API const float* qv_model_render_uvs(const qv_model* model);
+/* Bytes of scratch qv_instance_render needs for instances of this model (0 without a render mesh). */
+QV_API size_t qv_model_render_scratch_size(const qv_model* model);
+/* The render mesh's deformed positions (3 floats per render vertex; in the world in flight) and, when
+   `normals` is not NULL, its normals (the rest normals turned by their tet's deformation). `scratch`:
+   qv_model_render_scratch_size() bytes, 16-byte aligned, one per thread. Allocates nothing.
+   QV_ERROR_INVALID_ARGUMENT for a model without a render mesh or a null buffer. */
+QV_API qv_result qv_instance_render(const qv_instance* instance, float* positions, float* normals, void* scratch);
 
 #ifdef __cplusplus
 }

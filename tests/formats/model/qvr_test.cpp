@@ -202,6 +202,20 @@ TEST(Qvr, SeedsOfTheIndependentPythonWriterParse) {
     EXPECT_EQ(view.versionMinor, bytes == &newer ? 1 : 0);
     EXPECT_EQ(difference(formatModel(copyModel(view)), bytes == &newer ? f32 : *bytes), "");
   }
+  // A render mesh written from QVR.md alone: read as written, and the C++ writer gives the same bytes.
+  const std::string render = readFile(folder + "render_mesh.qvr");
+  ASSERT_FALSE(render.empty());
+  AlignedFile file(render);
+  ModelView view;
+  std::string error;
+  ASSERT_TRUE(file.parse(view, error)) << error;
+  EXPECT_EQ(view.renderVertexCount, 3u);
+  EXPECT_EQ(view.renderTriangleCount, 1u);
+  ASSERT_NE(view.renderNormals, nullptr);
+  ASSERT_NE(view.renderUVs, nullptr);
+  EXPECT_EQ(view.renderWeights[8], -0.5f);
+  EXPECT_EQ(view.renderBasis[5], 0.05f);
+  EXPECT_EQ(difference(formatModel(copyModel(view)), render), "");
 }
 
 // MODAL_ROTATIONS (type 10) is written with the optional flag, read back exactly, and a reader that

@@ -5,6 +5,7 @@
 // ENERGY_COEFFICIENTS at 576, BASIS at 832, REST_POSITIONS at 1024, ..., 1568 bytes in all.
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <string>
@@ -310,6 +311,50 @@ TEST(QvrValidation, TheRigidBodyRoundTripsAndIsChecked) {
   EXPECT_REFUSED(patched(f, at + 8 * 4, test::bitsOf(0.5), 8), section + "the second moments are not symmetric");
   c.rigidBody.pop_back();
   EXPECT_THROW(formatModel(c), std::runtime_error);
+}
+
+TEST(QvrValidation, TheRenderMeshRoundTripsAndIsChecked) {
+  test::Counts counts;
+  counts.withTets = true;
+  ModelContents c = test::syntheticModel(counts);
+  const size_t r = c.info.r;
+  ModelContents::RenderMesh& m = c.render;
+  m.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  m.triangles = {0, 1, 2};
+  m.tets = {0, 0, 1};
+  m.weights = {0.25f, 0.25f, 0.25f, 0.25f, 1, 0, 0, 0, -0.5f, 0.5f, 0.5f, 0.5f};
+  m.uvs = {0, 0, 1, 0, 0, 1};
+  m.basis.assign(9 * r, 0.125f);
+  const std::string f = formatModel(c);
+  {
+    test::AlignedFile file(f);
+    ModelView view;
+    std::string error;
+    ASSERT_TRUE(file.parse(view, error)) << error;
+    ASSERT_EQ(view.renderVertexCount, 3u);
+    EXPECT_EQ(view.renderNormals, nullptr);
+    const ModelContents back = copyModel(view);
+    EXPECT_EQ(back.render.weights, m.weights);
+    EXPECT_EQ(back.render.uvs, m.uvs);
+    EXPECT_EQ(back.render.basis, m.basis);
+  }
+  const uint64_t count = test::getLE(f, 20, 4);
+  const size_t at = test::getLE(f, entry(count - 1) + 8, 8);
+  ASSERT_EQ(test::getLE(f, entry(count - 1), 4), uint64_t{qvr::kRenderMesh});
+  const std::string section = "RENDER_MESH at byte " + std::to_string(at) + ": ";
+  const size_t triangles = at + 16 + 36, tetsAt = triangles + 12, weights = tetsAt + 12;
+  EXPECT_REFUSED(patched(f, at + 8, 4, 4), section + "unknown flags or a non-zero reserved word");
+  EXPECT_REFUSED(patched(f, at, 4, 4), section + "size");
+  EXPECT_REFUSED(patched(f, triangles + 4, 0, 4), section + "triangle entry 1 repeats a vertex of its triangle");
+  EXPECT_REFUSED(patched(f, triangles + 8, 3, 4), section + "triangle entry 2 (byte " + std::to_string(triangles + 8) + ") is 3, not below 3");
+  EXPECT_REFUSED(patched(f, tetsAt, c.info.tetCount, 4), section + "tet entry 0");
+  float bad = 0.5f;
+  uint32_t bits;
+  std::memcpy(&bits, &bad, 4);
+  EXPECT_REFUSED(patched(f, weights + 16, bits, 4), section + "vertex 1's weights are not those of a point in or near its tet");
+  EXPECT_REFUSED(patched(f, weights + 16 * 3 + 24 + 4, 0x7fc00000u, 4), section + "render basis value 1");
+  c.tets.clear();
+  EXPECT_THROW(formatModel(c), std::runtime_error);  // a render mesh needs the tets
 }
 
 } // namespace
