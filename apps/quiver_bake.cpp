@@ -20,8 +20,24 @@ int main(int argc, char** argv) {
   app::FixedVertexOptions fixedOptions;
   BakeSettings s;
   bool quiet = false;
-  meshOptions.addTo(app);
+  meshOptions.addTo(app, "Tetrahedral mesh (.msh .vtk .vtu .mesh .veg .node/.ele) or a closed triangle surface "
+                         "(.obj .gltf .glb .stl .ply .fbx .off ...), tetrahedralized by gmsh into NAME.tets.vtu");
   fixedOptions.addTo(app);
+  app.add_option("--tets", s.surface.mesher.targetTets, "A surface input: about this many tets")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--edge", s.surface.mesher.edgeLength, "A surface input: tet edge length in m (instead of --tets)")
+      ->check(app::Positive);
+  app.add_option("--min-dihedral", s.surface.mesher.minDihedral,
+                 "A surface input: the smallest dihedral angle every tet must reach, degrees (checked)")
+      ->check(CLI::Range(0.0, 60.0))->capture_default_str();
+  app.add_flag("--no-fill-holes{false}", s.surface.checks.fillHoles,
+               "A surface input: refuse holes instead of closing each with a fan around its centre");
+  app.add_option("--render-mesh", s.surface.renderMesh,
+                 "Triangle mesh drawn in place of the tets' surface, each vertex bound to its tet (default: the input "
+                 "when it is a surface); stored in NAME.qvr with its normals and UVs");
+  app.add_option("--embed-tolerance", s.surface.embedTolerance,
+                 "How far (m) outside the tets a render vertex may lie (default: two mean tet edges)")
+      ->check(app::Positive);
   app.add_option("--E", s.mesh.material.youngsModulus, "Young's modulus in Pa (> 0); overrides the mesh file's materials");
   app.add_option("--nu", s.mesh.material.poissonRatio, "Poisson ratio in (-1, 0.5); overrides the mesh file's materials");
   app.add_option("--density", s.mesh.material.density, "Density in kg/m^3 (> 0); overrides the mesh file's materials");

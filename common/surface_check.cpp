@@ -102,10 +102,12 @@ double enclosedVolume(const std::vector<double>& x, const std::vector<std::array
   return six / 6;
 }
 
-CheckedSurface checkSurface(const std::vector<double>& positions, const std::vector<int>& input, const std::string& name) {
+CheckedSurface checkSurface(const std::vector<double>& inputPositions, const std::vector<int>& input, const std::string& name,
+                            const SurfaceCheckOptions& options) {
   const auto fail = [&](const std::string& what) { throw MeshError(name + ": " + what); };
   CheckedSurface out;
-  out.positions = positions;
+  out.positions = inputPositions;
+  const std::vector<double>& positions = out.positions;  // holes add their centres
   const int n = static_cast<int>(positions.size() / 3);
   for (int v = 0; v < n; ++v)
     for (int a = 0; a < 3; ++a) {
@@ -136,19 +138,62 @@ CheckedSurface checkSurface(const std::vector<double>& positions, const std::vec
   if (degenerate) out.repairs.push_back("dropped " + std::to_string(degenerate) + " degenerate triangles (a repeated corner or no area)");
   if (repeated) out.repairs.push_back("dropped " + std::to_string(repeated) + " repeated triangles");
   if (tris.size() < 4) fail("no closed surface: " + std::to_string(tris.size()) + " usable triangles");
-  // Edges: each must have exactly two triangles.
+  // Edges: each must have exactly two triangles. Holes (edges of one) are closed when asked: each
+  // loop of open edges fanned around a new vertex at its centroid.
   std::map<Edge, std::vector<int>> edges;
-  for (size_t t = 0; t < tris.size(); ++t)
-    for (int k = 0; k < 3; ++k) edges[std::minmax(tris[t][k], tris[t][(k + 1) % 3])].push_back(static_cast<int>(t));
+  const auto countEdges = [&] {
+    edges.clear();
+    for (size_t t = 0; t < tris.size(); ++t)
+      for (int k = 0; k < 3; ++k) edges[std::minmax(tris[t][k], tris[t][(k + 1) % 3])].push_back(static_cast<int>(t));
+  };
+  countEdges();
   int open = 0, crowded = 0;
   Edge firstOpen{-1, -1}, firstCrowded{-1, -1};
+  std::multimap<int, int> openFrom;  // a hole's edges in their triangle's direction: from -> to
   for (const auto& [e, users] : edges) {
-    if (users.size() == 1 && !open++) firstOpen = e;
+    if (users.size() == 1) {
+      if (!open++) firstOpen = e;
+      const auto& t = tris[users[0]];
+      for (int k = 0; k < 3; ++k)
+        if (Edge(std::minmax(t[k], t[(k + 1) % 3])) == e) openFrom.emplace(t[k], t[(k + 1) % 3]);
+    }
     if (users.size() > 2 && !crowded++) firstCrowded = e;
   }
-  if (open)
+  if (open && !options.fillHoles)
     fail("not closed: " + std::to_string(open) + " open edges (holes), the first between " + where(positions, firstOpen.first) +
          " and " + where(positions, firstOpen.second) + "; close the holes in a modelling tool");
+  if (open && !crowded) {
+    int holes = 0;
+    double widest = 0;
+    while (!openFrom.empty()) {
+      std::vector<int> loop{openFrom.begin()->first};
+      while (true) {
+        const auto next = openFrom.find(loop.back());
+        if (next == openFrom.end()) break;
+        loop.push_back(next->second);
+        openFrom.erase(next);
+        if (loop.back() == loop.front()) break;
+      }
+      if (loop.size() < 4 || loop.back() != loop.front())
+        fail("not closed: an open boundary that is not a loop near " + where(positions, loop.front()) + "; close the holes in a modelling tool");
+      loop.pop_back();
+      Vec centre = Vec::Zero();
+      for (int v : loop) centre += at(out.positions, v);
+      centre /= double(loop.size());
+      for (int v : loop) widest = std::max(widest, 2 * (at(out.positions, v) - centre).norm());
+      const int c = static_cast<int>(out.positions.size() / 3);
+      out.positions.insert(out.positions.end(), {centre[0], centre[1], centre[2]});
+      for (size_t k = 0; k < loop.size(); ++k) tris.push_back({loop[(k + 1) % loop.size()], loop[k], c});
+      ++holes;
+    }
+    char text[160];
+    std::snprintf(text, sizeof text, "closed %d holes (%d open edges), the widest %.3g m across, each fanned around its centre", holes,
+                  open, widest);
+    out.repairs.push_back(text);
+    countEdges();
+    for (const auto& [e, users] : edges)
+      if (users.size() != 2 && !crowded++) firstCrowded = e;  // a loop through one vertex twice can make one
+  }
   if (crowded)
     fail(std::to_string(crowded) + " edges shared by more than two triangles (non-manifold), the first between " +
          where(positions, firstCrowded.first) + " and " + where(positions, firstCrowded.second));
@@ -197,21 +242,31 @@ CheckedSurface checkSurface(const std::vector<double>& positions, const std::vec
   }
   if (inward) out.repairs.push_back("turned " + std::to_string(inward) + " inward-facing pieces outward");
   const int main = static_cast<int>(std::max_element(volume.begin(), volume.end()) - volume.begin());
-  int inside = 0, apart = 0, firstApart = -1;
+  Eigen::AlignedBox3d box;
+  for (const auto& t : byPiece[main])
+    for (int v : t) box.extend(at(positions, v));
+  if (!(volume[main] > 1e-9 * box.diagonal().prod()))
+    fail("encloses no volume (" + std::to_string(volume[main]) + "): a flat or open sheet, not a solid");
+  // Pieces inside the main one, and small ones outside it (decorations: under 5% of its volume),
+  // are set aside: a render mesh carries them with the nearest tets.
+  int inside = 0, small = 0, apart = 0, firstApart = -1;
   for (int p = 0; p < pieces; ++p) {
     if (p == main) continue;
-    const double w = winding(positions, byPiece[main], at(positions, byPiece[p][0][0]));
-    if (w > 0.5) {
+    if (winding(positions, byPiece[main], at(positions, byPiece[p][0][0])) > 0.5) {
       ++inside;
+    } else if (volume[p] < 0.05 * volume[main]) {
+      ++small;
     } else if (!apart++) {
       firstApart = byPiece[p][0][0];
     }
   }
   if (apart)
-    fail(std::to_string(pieces) + " separate pieces: " + std::to_string(apart) + " lie outside the largest, the first at " +
+    fail(std::to_string(pieces) + " separate pieces: " + std::to_string(apart) + " outside the largest hold 5% of its volume or more, the first at " +
          where(positions, firstApart) + "; bake each piece on its own, or join them into one closed surface");
   if (inside)
     out.repairs.push_back("set aside " + std::to_string(inside) + " pieces inside the largest (they are carried, not simulated)");
+  if (small)
+    out.repairs.push_back("set aside " + std::to_string(small) + " small pieces outside the largest (under 5% of its volume: carried, not simulated)");
   out.triangles = byPiece[main];
   out.volume = volume[main];
   const auto crossing = crossings(positions, out.triangles, 1000);

@@ -13,14 +13,19 @@
 namespace quiver {
 
 struct CheckedSurface {
-  std::vector<double> positions;              // 3 per vertex, as given
+  std::vector<double> positions;              // 3 per vertex, as given (and the centres of closed holes)
   std::vector<std::array<int, 3>> triangles;  // the main piece, consistently outward
   std::vector<std::string> repairs;           // what was changed, one sentence each
   double volume = 0;                          // enclosed by `triangles`
 };
 
+struct SurfaceCheckOptions {
+  bool fillHoles = false;  // close each hole (a loop of open edges) with a fan around its centre, and say so
+};
+
 // Throws MeshError "NAME: ..." naming the problem, its count and the first place.
-CheckedSurface checkSurface(const std::vector<double>& positions, const std::vector<int>& triangles, const std::string& name);
+CheckedSurface checkSurface(const std::vector<double>& positions, const std::vector<int>& triangles, const std::string& name,
+                            const SurfaceCheckOptions& options = {});
 
 // Signed volume enclosed by closed, consistently oriented triangles (positive when outward).
 double enclosedVolume(const std::vector<double>& positions, const std::vector<std::array<int, 3>>& triangles);

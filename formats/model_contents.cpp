@@ -88,4 +88,30 @@ ModelContents makeModelContents(const CheckedMesh& mesh, const std::vector<Mater
   return c;
 }
 
+ModelContents::RenderMesh makeRenderMesh(const SurfaceMesh::Render& render, const TetMesh& mesh, const Embedding& embedding,
+                                         const Eigen::MatrixXd& basis) {
+  ModelContents::RenderMesh out;
+  out.positions = render.positions;
+  out.normals = render.normals;
+  out.uvs = render.uvs;
+  for (size_t t = 0; t + 2 < render.triangles.size(); t += 3) {
+    const uint32_t a = render.triangles[t], b = render.triangles[t + 1], c = render.triangles[t + 2];
+    if (a != b && b != c && a != c) out.triangles.insert(out.triangles.end(), {a, b, c});
+  }
+  const size_t V = render.positions.size() / 3, r = static_cast<size_t>(basis.cols());
+  out.basis.reserve(3 * V * r);
+  for (size_t i = 0; i < V; ++i) {
+    const Tet& tet = mesh.tets[static_cast<size_t>(embedding.tet[i])];
+    out.tets.push_back(static_cast<uint32_t>(embedding.tet[i]));
+    for (double w : embedding.weights[i]) out.weights.push_back(static_cast<float>(w));
+    for (int a = 0; a < 3; ++a)
+      for (size_t j = 0; j < r; ++j) {
+        double row = 0;
+        for (int k = 0; k < 4; ++k) row += embedding.weights[i][k] * basis(3 * tet[k] + a, static_cast<Eigen::Index>(j));
+        out.basis.push_back(static_cast<float>(row));
+      }
+  }
+  return out;
+}
+
 } // namespace quiver

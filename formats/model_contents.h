@@ -8,7 +8,9 @@
 
 #include <Eigen/Core>
 
+#include "common/embedding.h"
 #include "common/mesh_checks.h"
+#include "formats/mesh/read_surface.h"
 #include "formats/model/qvr_writer.h"
 
 namespace quiver {
@@ -26,5 +28,10 @@ ModelContents makeModelContents(const CheckedMesh& mesh, const std::vector<Mater
                                 const Eigen::MatrixXd& basis, const std::vector<double>& energy,
                                 const std::vector<double>& eigenvalues, const Eigen::MatrixXd& gravity,
                                 const ExportSettings& settings);
+
+// The RENDER_MESH of `render` (a surface as the file gives it) bound to the tets by `embedding`:
+// render basis rows W U from `basis` (3n x r). Triangles with a repeated corner are left out.
+ModelContents::RenderMesh makeRenderMesh(const SurfaceMesh::Render& render, const TetMesh& mesh, const Embedding& embedding,
+                                         const Eigen::MatrixXd& basis);
 
 } // namespace quiver

@@ -101,8 +101,11 @@ void checkBakeSettings(const BakeSettings& s) {
 void runBake(const BakeContext& ctx, const BakeSettings& s) {
   checkBakeSettings(s);
   StageRunner stages(ctx, s.resume);
-  const MeshInputs in = stages.run("mesh", [&] { return loadMeshInputs(s.mesh); });
-  warnAboutMesh(ctx, in, s.mesh);
+  MeshSettings meshSettings = s.mesh;
+  if (!isTetMeshPath(s.mesh.path)) meshSettings.path = meshSurface(ctx, s.mesh.path, s.surface, s.output.name);
+  const MeshInputs in = stages.run("mesh", [&] { return loadMeshInputs(meshSettings); });
+  warnAboutMesh(ctx, in, meshSettings);
+  const RenderInputs render = bindRenderMesh(ctx, s.mesh.path, s.surface, in.mesh.mesh);
   // An eigensolver needs more DOFs than modes (k at the free DOFs leaves it no room to iterate).
   if (s.modes + (in.freeObject() ? 6 : 0) >= in.freeDofs || s.basis.settings.rank > in.freeDofs)
     throw std::invalid_argument("the mesh has " + std::to_string(in.freeDofs) + " free DOFs: too few for --modes " +
@@ -144,7 +147,7 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   const FidelityReport fidelity =
       s.fidelity.enabled ? fidelityStage(stages, ctx, in, fullU, modes, *archive) : FidelityReport{};
   const std::string qvr = stages.run("export", [&] {
-    return exportModel(ctx, s.output, in, layout, modes, fullU, energy, fidelity);
+    return exportModel(ctx, s.output, in, layout, modes, fullU, energy, fidelity, render);
   });
   stages.report(qvr);
 

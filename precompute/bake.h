@@ -12,11 +12,13 @@
 #include "precompute/stages/export_model.h"
 #include "precompute/stages/fidelity.h"
 #include "precompute/stages/mesh.h"
+#include "precompute/stages/surface.h"
 
 namespace quiver {
 
 struct BakeSettings {
   MeshSettings mesh;           // the mesh, its checks, fixed vertices and materials (stages/mesh.h)
+  SurfaceSettings surface;     // a surface input's tets, and the render mesh (stages/surface.h)
   int modes = 20;              // k, linear modes
   BasisRequest basis;          // r and the recipe, or a user basis (stages/basis.h)
   ExportRequest output;        // NAME, how NAME.qvr stores the model, the .npy exports (stages/export_model.h)

@@ -17,13 +17,6 @@ namespace quiver {
 
 namespace {
 
-bool isTetMeshFile(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".vtu" || ext == ".vtk" || ext == ".msh" || ext == ".mesh" || ext == ".veg" || ext == ".node" ||
-         ext == ".ele";
-}
-
 SurfaceMesh tetBoundary(const std::string& path) {
   const CheckedMesh checked = loadMesh(path);
   SurfaceMesh s;
@@ -34,18 +27,44 @@ SurfaceMesh tetBoundary(const std::string& path) {
 
 } // namespace
 
+bool isTetMeshPath(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".vtu" || ext == ".vtk" || ext == ".msh" || ext == ".mesh" || ext == ".veg" || ext == ".node" ||
+         ext == ".ele";
+}
+
 SurfaceMesh readSurfaceFile(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw MeshError(path + ": cannot open: no such file");
-  if (isTetMeshFile(path)) return tetBoundary(path);
+  if (isTetMeshPath(path)) return tetBoundary(path);
   Assimp::Importer importer;
   // Points and lines are dropped by the importer; what remains is triangles.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType);
+  const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType |
+                                                     aiProcess_GenSmoothNormals | aiProcess_ValidateDataStructure);
   if (!scene || !scene->mRootNode) throw MeshError(path + ": cannot read: " + importer.GetErrorString());
   SurfaceMesh s;
   std::map<std::array<double, 3>, int> welded;
+  bool anyUVs = false;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) anyUVs = anyUVs || scene->mMeshes[m]->HasTextureCoords(0);
+  SurfaceMesh::Render& render = s.render;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh* mesh = scene->mMeshes[m];
+    const uint32_t first = static_cast<uint32_t>(render.positions.size() / 3);
+    for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+      const aiVector3D &p = mesh->mVertices[v], n = mesh->HasNormals() ? mesh->mNormals[v] : aiVector3D(0, 0, 1);
+      render.positions.insert(render.positions.end(), {p.x, p.y, p.z});
+      render.normals.insert(render.normals.end(), {std::isfinite(n.x) ? n.x : 0, std::isfinite(n.y) ? n.y : 0, std::isfinite(n.z) ? n.z : 1});
+      if (anyUVs) {
+        const aiVector3D uv = mesh->HasTextureCoords(0) ? mesh->mTextureCoords[0][v] : aiVector3D(0, 0, 0);
+        render.uvs.insert(render.uvs.end(), {std::isfinite(uv.x) ? uv.x : 0, std::isfinite(uv.y) ? uv.y : 0});
+      }
+    }
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices == 3)
+        for (int k = 0; k < 3; ++k) render.triangles.push_back(first + face.mIndices[k]);
+    }
     std::vector<int> index(mesh->mNumVertices);
     for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
       const aiVector3D& p = mesh->mVertices[v];

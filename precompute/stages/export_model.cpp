@@ -21,7 +21,8 @@ std::vector<double> inFileOrder(const Eigen::MatrixXd& full, const CheckedMesh& 
 
 std::string exportModel(const BakeContext& ctx, const ExportRequest& request, const MeshInputs& in,
                         const DofLayout& layout, const LinearModes& modes,
-                        const Eigen::MatrixXd& fullU, const EnergyPolynomial& energy, const FidelityReport& fidelity) {
+                        const Eigen::MatrixXd& fullU, const EnergyPolynomial& energy, const FidelityReport& fidelity,
+                        const RenderInputs& render) {
   // Gravity projection U^T M e_a: the reduced force of a unit acceleration along each axis. M is
   // the whole mesh's consistent mass: a free vertex also carries weight it shares with its fixed
   // neighbours, which the assembled free-DOF matrix leaves out (2% of the sag on a 3-cell beam).
@@ -36,6 +37,7 @@ std::string exportModel(const BakeContext& ctx, const ExportRequest& request, co
   for (const FidelityCase& c : fidelity.cases)
     contents.fidelityCases.push_back({c.name, c.error, c.largestDisplacement});
   contents.fidelityFrequencyErrors = fidelity.frequencyErrors;
+  if (!render.path.empty()) contents.render = makeRenderMesh(render.render, in.mesh.mesh, render.embedding, fullU);
   const std::string path = request.name + ".qvr";
   ctx.onRankZero([&] { writeModelFile(path, contents); });
   if (request.exportNpy) {

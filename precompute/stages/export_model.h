@@ -13,6 +13,7 @@
 #include "precompute/stages/mesh.h"
 #include "precompute/stages/modes.h"
 #include "precompute/stages/polynomials.h"
+#include "precompute/stages/surface.h"
 
 namespace quiver {
 
@@ -25,6 +26,7 @@ struct ExportRequest {
 // `fullU`: the basis gathered to every rank (3n x r, vertex order). Returns the .qvr's path.
 std::string exportModel(const BakeContext& ctx, const ExportRequest& request, const MeshInputs& inputs,
                         const DofLayout& layout, const LinearModes& modes,
-                        const Eigen::MatrixXd& fullU, const EnergyPolynomial& energy, const FidelityReport& fidelity);
+                        const Eigen::MatrixXd& fullU, const EnergyPolynomial& energy, const FidelityReport& fidelity,
+                        const RenderInputs& render);
 
 } // namespace quiver

@@ -87,7 +87,8 @@ TEST(SurfaceCheck, EveryOtherProblemIsNamedWithItsCount) {
   Soup two;
   addCube(two, 0, 1);
   addCube(two, 3, 1);
-  EXPECT_NE(errorOf(two).find("2 separate pieces: 1 lie outside the largest, the first at vertex 8 (3, 3, 3)"), std::string::npos)
+  EXPECT_NE(errorOf(two).find("2 separate pieces: 1 outside the largest hold 5% of its volume or more, the first at vertex 8 (3, 3, 3)"),
+            std::string::npos)
       << errorOf(two);
   Soup folded;  // a corner pushed through the opposite face
   addCube(folded, 0, 1);

@@ -1,0 +1,52 @@
+#include "precompute/stages/surface.h"
+
+#include <cstdio>
+#include <iostream>
+
+#include "common/mesh_error.h"
+#include "common/mesh_quality.h"
+#include "common/surface_check.h"
+#include "formats/mesh/write_mesh.h"
+
+namespace quiver {
+
+std::string meshSurface(const BakeContext& ctx, const std::string& input, const SurfaceSettings& s, const std::string& outputName) {
+  const std::string path = outputName + ".tets.vtu";
+  ctx.onRankZero([&] {
+    const SurfaceMesh surface = readSurfaceFile(input);
+    const CheckedSurface checked = checkSurface(surface.positions, surface.triangles, input, s.checks);
+    for (const std::string& repair : checked.repairs) std::cerr << "quiver-bake: warning: " << input << ": " << repair << "\n";
+    const MesherResult tets = tetrahedralize(checked, s.mesher, input);
+    writeMeshFile(path, tets.mesh);
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "%s: %zu triangles -> %d tets (edge %.3g m) by gmsh in %.1f s, smallest dihedral angle %.1f degrees "
+                  "(floor %.1f); volume %.6g m^3 (surface %.6g m^3)",
+                  input.c_str(), checked.triangles.size(), tets.mesh.tetCount(), tets.edgeLength, tets.seconds, tets.minDihedral,
+                  s.mesher.minDihedral, totalVolume(tets.mesh), checked.volume);
+    ctx.progress(text);
+    ctx.progress("wrote " + path);
+  });
+  return path;
+}
+
+RenderInputs bindRenderMesh(const BakeContext& ctx, const std::string& input, const SurfaceSettings& s, const TetMesh& mesh) {
+  RenderInputs out;
+  out.path = !s.renderMesh.empty() ? s.renderMesh : isTetMeshPath(input) ? "" : input;
+  if (out.path.empty()) return out;
+  out.render = readSurfaceFile(out.path).render;
+  if (out.render.triangles.empty())
+    throw MeshError(out.path + ": --render-mesh needs a triangle mesh file (OBJ, glTF, STL, PLY, FBX, ...), not a tet mesh");
+  double tolerance = s.embedTolerance;
+  if (!(tolerance > 0)) tolerance = 2 * measureQuality(mesh).edgeLength.mean;  // thin features the tets do not reach
+  std::vector<double> points(out.render.positions.begin(), out.render.positions.end());
+  out.embedding = embedPoints(mesh, points, tolerance, out.path);
+  char text[240];
+  std::snprintf(text, sizeof text, "render mesh %s: %zu vertices, %zu triangles; %d outside the tets, at most %.3g m (tolerance %.3g m)",
+                out.path.c_str(), points.size() / 3, out.render.triangles.size() / 3, out.embedding.outside, out.embedding.farthest,
+                tolerance);
+  ctx.progress(text);
+  return out;
+}
+
+} // namespace quiver
