@@ -46,7 +46,7 @@ void renderFlight(const RuntimeModel& model, const RenderOptions& o, int width, 
   const auto keep = [&] {
     std::vector<float> all;
     for (int k = 0; k < target.flight()->bodyCount(); ++k) {
-      const std::vector<float> p = target.flight()->body(k).positions();
+      const std::vector<float> p = target.flight()->body(k).shownPositions();
       all.insert(all.end(), p.begin(), p.end());
     }
     shots.push_back(std::move(all));
@@ -64,9 +64,9 @@ void renderFlight(const RuntimeModel& model, const RenderOptions& o, int width, 
   for (int k = 0; k < colliders.size(); ++k) appendCollider(colliders[k], colliders.surface(k), lo, hi, world);
   const Camera cam = Camera::framing(lo - grow, hi + grow, width, height);
   std::vector<unsigned> triangles;
-  const std::vector<unsigned> one = model.triangles();
+  const std::vector<unsigned> one = model.shownTriangles();
   for (int k = 0; k < target.flight()->bodyCount(); ++k)
-    for (unsigned index : one) triangles.push_back(index + static_cast<unsigned>(k * model.info().vertex_count));
+    for (unsigned index : one) triangles.push_back(index + static_cast<unsigned>(k * model.shownVertexCount()));
   for (const auto& p : shots) {
     Image image(width, height);
     image.clear(kWhite);
@@ -158,8 +158,8 @@ int renderModel(const std::string& path, const RenderOptions& o) {
   RuntimeTarget target(model, o.scenario.step);
   FrameWriter frames(o.output, o.every * target.timeStep());
   const Camera cam = camera(model.info(), width, height, 0.15);
-  const std::vector<unsigned> triangles = model.triangles();
-  const auto draw = [&] { frames.add(picture(cam, width, height, target.instance().positions(), triangles)); };
+  const std::vector<unsigned> triangles = model.shownTriangles();  // the render mesh when it has one
+  const auto draw = [&] { frames.add(picture(cam, width, height, target.instance().shownPositions(), triangles)); };
   if (!o.scenario.hasLoad()) {
     if (frames.animated()) throw std::runtime_error("nothing moves: give a scenario (--force, --drag, --twist, --gravity) or --modes");
     draw();

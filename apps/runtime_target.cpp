@@ -57,6 +57,18 @@ void RuntimeTarget::displacement(int body, std::vector<double>& u) const {
   for (size_t i = 0; i < p.size(); ++i) u[i] = p[i] - rest[i];
 }
 
+std::vector<unsigned> RuntimeTarget::renderTriangles() const {
+  return model_.info().render_vertex_count ? model_.shownTriangles() : std::vector<unsigned>{};
+}
+
+void RuntimeTarget::renderFrame(int body, std::vector<float>& positions, std::vector<float>& normals) const {
+  const size_t V = static_cast<size_t>(model_.info().render_vertex_count);
+  positions.resize(3 * V);
+  normals.resize(3 * V);
+  std::vector<double> scratch(qv_model_render_scratch_size(model_.get()) / sizeof(double) + 1);
+  qv_instance_render((flight_ ? flight_->body(body) : instance_).get(), positions.data(), normals.data(), scratch.data());
+}
+
 void RuntimeTarget::energies(double& kinetic, double& elastic) const {
   qv_instance_energies(instance_.get(), &kinetic, &elastic);
 }

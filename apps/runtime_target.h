@@ -21,6 +21,8 @@ public:
   int step(int& newtonIterations) override;
   int bodyCount() const override { return flight_ ? flight_->bodyCount() : 1; }
   void displacement(int body, std::vector<double>& u) const override;
+  std::vector<unsigned> renderTriangles() const override;
+  void renderFrame(int body, std::vector<float>& positions, std::vector<float>& normals) const override;
   void energies(double& kinetic, double& elastic) const override;
   double timeStep() const override { return instance_.config().time_step; }
 

@@ -59,7 +59,10 @@ int simulateModel(const std::string& path, const SimOptions& o) {
     std::cout << "quiver sim: " << o.steps << " steps of r = " << model.info().r << ": median " << median << " us, p99 "
               << p99 << " us per step, " << static_cast<long>(1e6 * o.steps / total) << " steps per second"
               << (result.failedSteps ? ", " + std::to_string(result.failedSteps) + " resets" : std::string()) << "\n";
-    if (!o.output.empty()) std::cout << "quiver sim: wrote " << o.output << ".pvd (open in ParaView) and " << o.output << ".csv\n";
+    if (!o.output.empty())
+      std::cout << "quiver sim: wrote " << o.output << ".pvd (open in ParaView)"
+                << (model.info().render_vertex_count ? ", " + o.output + "_render.pvd (the render mesh)" : std::string()) << " and "
+                << o.output << ".csv\n";
   }
   return result.failedSteps > 0 ? 2 : 0;
 }

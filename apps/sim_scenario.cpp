@@ -114,6 +114,8 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
   if (!o.output.empty() && std::filesystem::path(o.output).has_parent_path())
     std::filesystem::create_directories(std::filesystem::path(o.output).parent_path());
   const double h = target.timeStep();
+  const std::vector<unsigned> renderTriangles = target.renderTriangles();
+  std::string renderPvd = pvd;
   if (afterStep) afterStep(0);  // the start, set up
   for (int step = 0; step < o.steps; ++step) {
     if (step < o.holdSteps && dragMode) {
@@ -154,12 +156,18 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
           std::snprintf(name, sizeof name, "_%05d_%d.vtu", step + 1, body);
         }
         writeFileAtomically(o.output + name, formatVtu(mesh, {field}));
-        pvd += "<DataSet timestep=\"" + std::to_string((step + 1) * h) + "\" part=\"" + std::to_string(body) + "\" file=\"" +
-               stem + name + "\"/>\n";
+        const std::string entry = "<DataSet timestep=\"" + std::to_string((step + 1) * h) + "\" part=\"" + std::to_string(body) + "\" file=\"";
+        pvd += entry + stem + name + "\"/>\n";
+        if (renderTriangles.empty()) continue;
+        std::vector<float> positions, normals;
+        target.renderFrame(body, positions, normals);
+        writeFileAtomically(o.output + "_render" + name, formatTriangleVtu(positions, renderTriangles, normals));
+        renderPvd += entry + stem + "_render" + name + "\"/>\n";
       }
   }
   if (!o.output.empty()) {
     writeFileAtomically(o.output + ".pvd", pvd + "</Collection>\n</VTKFile>\n");
+    if (!renderTriangles.empty()) writeFileAtomically(o.output + "_render.pvd", renderPvd + "</Collection>\n</VTKFile>\n");
     writeFileAtomically(o.output + ".csv", csv.str());
   }
   return result;

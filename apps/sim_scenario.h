@@ -28,7 +28,8 @@ struct SimOptions {
   FlightSetup flight;                   // --free (step.freeFlight): where the bodies start, what they touch
   StepSettings step;                    // integrator, elasticity, time step, Newton iterations per step
                                         // (runtime; full space: at most), Rayleigh damping
-  std::string output;                   // NAME: NAME.pvd, NAME_NNNNN.vtu (a pile: NAME_NNNNN_K.vtu, body K), NAME.csv; "" for none
+  std::string output;                   // NAME: NAME.pvd, NAME_NNNNN.vtu (a pile: NAME_NNNNN_K.vtu, body K), NAME.csv,
+                                        // and a render mesh's NAME_render.pvd, NAME_render_NNNNN[_K].vtu; "" for none
   int every = 1;                        // write every k-th step
   bool json = false;                    // print one JSON summary instead of text
   std::string scenarioFile;             // --scenario: expanded before parsing (apps/support/scenario_file.h)
@@ -57,6 +58,9 @@ public:
   virtual int step(int& newtonIterations) = 0;
   virtual int bodyCount() const { return 1; }  // a --pile flies more
   virtual void displacement(int body, std::vector<double>& u) const = 0;  // 3 per vertex, from the rest shape
+  // A render mesh's triangles (none: the target has none) and a body's positions and normals on it.
+  virtual std::vector<unsigned> renderTriangles() const { return {}; }
+  virtual void renderFrame(int /*body*/, std::vector<float>& /*positions*/, std::vector<float>& /*normals*/) const {}
   virtual void energies(double& kinetic, double& elastic) const = 0;
   virtual double timeStep() const = 0;
 };

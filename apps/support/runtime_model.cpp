@@ -21,6 +21,14 @@ std::vector<unsigned> RuntimeModel::triangles() const {
   return std::vector<unsigned>(t, t + 3 * static_cast<size_t>(info_.triangle_count));
 }
 
+std::vector<unsigned> RuntimeModel::shownTriangles() const {
+  if (!info_.render_vertex_count) return triangles();
+  const unsigned* t = qv_model_render_triangles(model_);
+  return std::vector<unsigned>(t, t + 3 * static_cast<size_t>(info_.render_triangle_count));
+}
+
+int RuntimeModel::shownVertexCount() const { return info_.render_vertex_count ? info_.render_vertex_count : info_.vertex_count; }
+
 void RuntimeModel::positionsAt(const double* q, std::vector<float>& out) const {
   out.resize(3 * static_cast<size_t>(info_.vertex_count));
   qv_model_displacements(model_, q, out.data());
@@ -45,7 +53,7 @@ TetMesh RuntimeModel::mesh() const {
 }
 
 RuntimeInstance::RuntimeInstance(const RuntimeModel& model, const qv_instance_config& config)
-    : config_(config), vertexCount_(static_cast<size_t>(model.info().vertex_count)) {
+    : model_(model.get()), config_(config), vertexCount_(static_cast<size_t>(model.info().vertex_count)) {
   if (qv_instance_create(model.get(), &config_, nullptr, &instance_) != QV_OK)
     throw std::runtime_error(config_.elasticity == QV_ELASTICITY_MODAL_WARPING && !model.info().has_modal_rotations
                                  ? model.path() + " has no modal rotations (bake it again for modal warping)"
@@ -59,6 +67,16 @@ RuntimeInstance::~RuntimeInstance() { qv_instance_destroy(instance_); }
 std::vector<float> RuntimeInstance::positions() const {
   std::vector<float> p(3 * vertexCount_);
   qv_instance_positions(instance_, p.data());
+  return p;
+}
+
+std::vector<float> RuntimeInstance::shownPositions() const {
+  qv_model_info info;
+  qv_model_get_info(model_, &info);
+  if (!info.render_vertex_count) return positions();
+  std::vector<float> p(3 * static_cast<size_t>(info.render_vertex_count));
+  scratch_.resize(qv_model_render_scratch_size(model_) / sizeof(double) + 1);
+  qv_instance_render(instance_, p.data(), nullptr, scratch_.data());
   return p;
 }
 

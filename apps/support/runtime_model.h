@@ -20,6 +20,10 @@ public:
   const qv_model_info& info() const { return info_; }
   const std::string& path() const { return path_; }
   std::vector<unsigned> triangles() const;
+  // What the tools draw: the render mesh when the model has one, else the tets' surface (all
+  // vertices, those off the surface unused). shownVertexCount() positions go with them.
+  std::vector<unsigned> shownTriangles() const;
+  int shownVertexCount() const;
   // Positions X + U q (3 floats per vertex) of reduced coordinates `q` (r values), without an instance.
   void positionsAt(const double* q, std::vector<float>& out) const;
   // Rest shape and tets, for vertex selection and .vtu frames.
@@ -42,9 +46,13 @@ public:
   qv_instance* get() const { return instance_; }
   const qv_instance_config& config() const { return config_; }
   std::vector<float> positions() const;  // 3 per vertex
+  // The render mesh's positions (qv_instance_render) when the model has one, else positions().
+  std::vector<float> shownPositions() const;
 
 private:
   qv_instance* instance_ = nullptr;
+  const qv_model* model_ = nullptr;
+  mutable std::vector<double> scratch_;  // qv_instance_render's
   qv_instance_config config_;
   size_t vertexCount_;
 };

@@ -25,23 +25,15 @@ SurfaceMesh tetBoundary(const std::string& path) {
   return s;
 }
 
-} // namespace
+// Points and lines are dropped by the importer; what remains is triangles, checked.
+constexpr unsigned kSteps = aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType |
+                            aiProcess_GenSmoothNormals | aiProcess_ValidateDataStructure;
 
-bool isTetMeshPath(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".vtu" || ext == ".vtk" || ext == ".msh" || ext == ".mesh" || ext == ".veg" || ext == ".node" ||
-         ext == ".ele";
+void configure(Assimp::Importer& importer) {
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
 }
 
-SurfaceMesh readSurfaceFile(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw MeshError(path + ": cannot open: no such file");
-  if (isTetMeshPath(path)) return tetBoundary(path);
-  Assimp::Importer importer;
-  // Points and lines are dropped by the importer; what remains is triangles.
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType |
-                                                     aiProcess_GenSmoothNormals | aiProcess_ValidateDataStructure);
+SurfaceMesh fromScene(const aiScene* scene, const Assimp::Importer& importer, const std::string& path) {
   if (!scene || !scene->mRootNode) throw MeshError(path + ": cannot read: " + importer.GetErrorString());
   SurfaceMesh s;
   std::map<std::array<double, 3>, int> welded;
@@ -83,6 +75,29 @@ SurfaceMesh readSurfaceFile(const std::string& path) {
   }
   if (s.triangles.empty()) throw MeshError(path + ": holds no triangle");
   return s;
+}
+
+} // namespace
+
+bool isTetMeshPath(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".vtu" || ext == ".vtk" || ext == ".msh" || ext == ".mesh" || ext == ".veg" || ext == ".node" ||
+         ext == ".ele";
+}
+
+SurfaceMesh readSurfaceFile(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) throw MeshError(path + ": cannot open: no such file");
+  if (isTetMeshPath(path)) return tetBoundary(path);
+  Assimp::Importer importer;
+  configure(importer);
+  return fromScene(importer.ReadFile(path, kSteps), importer, path);
+}
+
+SurfaceMesh readSurfaceMemory(const void* data, size_t size, const std::string& extension, const std::string& name) {
+  Assimp::Importer importer;
+  configure(importer);
+  return fromScene(importer.ReadFileFromMemory(data, size, kSteps, extension.c_str()), importer, name);
 }
 
 } // namespace quiver

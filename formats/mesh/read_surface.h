@@ -1,6 +1,7 @@
 #pragma once
 // Reading triangle surfaces: artists' formats through Assimp (OBJ, STL, PLY, glTF/GLB, FBX, OFF and
 // the rest it knows), or the boundary of a tet mesh in any format readMeshFile() reads.
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -23,6 +24,9 @@ struct SurfaceMesh {
 // vertices at the same position welded (formats split them by normal or UV). Points and lines are
 // left out. Throws MeshError "PATH: ..." when the file cannot be read or holds no triangle.
 SurfaceMesh readSurfaceFile(const std::string& path);
+// The same from bytes in memory, in the format of `extension` ("obj", "stl", "ply", "glb", ...);
+// messages name `name`. (Formats that refer to other files cannot find them.)
+SurfaceMesh readSurfaceMemory(const void* data, size_t size, const std::string& extension, const std::string& name);
 
 // Whether `path` names a tet mesh by its extension (.vtu .vtk .msh .mesh .veg .node .ele); any
 // other file is a surface for Assimp.

@@ -485,4 +485,29 @@ std::string formatVtu(const TetMesh& mesh, const std::vector<PointField>& fields
   return w.finish();
 }
 
+std::string formatTriangleVtu(const std::vector<float>& positions, const std::vector<unsigned>& triangles,
+                              const std::vector<float>& normals) {
+  VtuWriter w(VtuEncoding::AppendedRaw);
+  const size_t points = positions.size() / 3, cells = triangles.size() / 3;
+  w.xml = std::string("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"") +
+          (hostIsLittleEndian() ? "LittleEndian" : "BigEndian") + "\" header_type=\"UInt64\">\n" +
+          "  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"" + std::to_string(points) + "\" NumberOfCells=\"" +
+          std::to_string(cells) + "\">\n";
+  if (!normals.empty()) {
+    w.xml += "      <PointData Normals=\"normal\">\n";
+    w.dataArray("Float32", "normal", 3, normals);
+    w.xml += "      </PointData>\n";
+  }
+  w.xml += "      <Points>\n";
+  w.dataArray("Float32", "Points", 3, positions);
+  w.xml += "      </Points>\n      <Cells>\n";
+  std::vector<int64_t> connectivity(triangles.begin(), triangles.end()), offsets;
+  for (size_t c = 1; c <= cells; ++c) offsets.push_back(static_cast<int64_t>(3 * c));
+  w.dataArray("Int64", "connectivity", 1, connectivity);
+  w.dataArray("Int64", "offsets", 1, offsets);
+  w.dataArray("UInt8", "types", 1, std::vector<uint8_t>(cells, static_cast<uint8_t>(5)));  // VTK_TRIANGLE
+  w.xml += "      </Cells>\n    </Piece>\n";
+  return w.finish();
+}
+
 } // namespace quiver

@@ -20,6 +20,9 @@ enum class VtuEncoding { Ascii, AppendedRaw };
 
 std::string formatVtu(const TetMesh& mesh, const std::vector<PointField>& fields = {},
                       VtuEncoding encoding = VtuEncoding::AppendedRaw);
+// A triangle surface (a render mesh's frame) as .vtu: float32 points, per-point normals when given.
+std::string formatTriangleVtu(const std::vector<float>& positions, const std::vector<unsigned>& triangles,
+                              const std::vector<float>& normals = {});
 std::string formatVtkLegacy(const TetMesh& mesh, const std::vector<PointField>& fields = {});  // ASCII
 std::string formatGmsh(const TetMesh& mesh);   // Gmsh 4.1 ASCII; regions become physical volumes
 std::string formatMedit(const TetMesh& mesh);  // regions become element references

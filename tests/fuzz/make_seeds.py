@@ -124,6 +124,27 @@ def write_qvr_seeds():
     open(write("qvr", "render_mesh.qvr"), "wb").write(qvr_file(qvr_sections(32, True) + [(13, 1, render)]))
 
 
+def write_surface_seeds():
+    """Small closed surfaces for fuzz_surface: the first byte picks the format (0 obj, 1 stl, 2 ply,
+    3 off, 4 gltf, 5 glb), the rest is the file."""
+    corners = [(x, y, z) for z in (0, 1) for y in (0, 1) for x in (0, 1)]
+    quads = [(0, 4, 6, 2), (1, 3, 7, 5), (0, 1, 5, 4), (2, 6, 7, 3), (0, 2, 3, 1), (4, 5, 7, 6)]
+    tris = [t for q in quads for t in ((q[0], q[1], q[2]), (q[0], q[2], q[3]))]
+    obj = "".join(f"v {x} {y} {z}\n" for x, y, z in corners) + "vt 0 0\nvn 0 0 1\n"
+    obj += "".join("f " + " ".join(f"{i + 1}/1/1" for i in q) + "\n" for q in quads)
+    stl = "solid cube\n" + "".join("facet normal 0 0 0\nouter loop\n" + "".join(
+        "vertex {} {} {}\n".format(*corners[i]) for i in t) + "endloop\nendfacet\n" for t in tris) + "endsolid cube\n"
+    binary = bytes(80) + struct.pack("<I", len(tris)) + b"".join(
+        struct.pack("<12fH", 0, 0, 0, *[c for i in t for c in corners[i]], 0) for t in tris)
+    ply = ("ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+           "element face 6\nproperty list uchar int vertex_indices\nend_header\n")
+    ply += "".join(f"{x} {y} {z}\n" for x, y, z in corners) + "".join("4 " + " ".join(map(str, q)) + "\n" for q in quads)
+    off = "OFF\n8 6 0\n" + "".join(f"{x} {y} {z}\n" for x, y, z in corners) + "".join("4 " + " ".join(map(str, q)) + "\n" for q in quads)
+    for name, kind, data in (("cube.obj", 0, obj.encode()), ("cube_ascii.stl", 1, stl.encode()), ("cube_binary.stl", 1, binary),
+                             ("cube.ply", 2, ply.encode()), ("cube.off", 3, off.encode())):
+        open(write("surface", name), "wb").write(bytes([kind]) + data)
+
+
 def main():
     shutil.rmtree(SEEDS, ignore_errors=True)
     m = mesh()
@@ -171,6 +192,7 @@ def main():
     np.save(write("npy", "int32.npy"), np.arange(4, dtype="<i4"))
 
     write_qvr_seeds()
+    write_surface_seeds()
 
 
 if __name__ == "__main__":
