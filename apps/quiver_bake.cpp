@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
                  "Triangle mesh drawn in place of the tets' surface, each vertex bound to its tet (default: the input "
                  "when it is a surface); stored in NAME.qvr with its normals and UVs");
   app.add_option("--embed-tolerance", s.surface.embedTolerance,
-                 "How far (m) outside the tets a render vertex may lie (default: two mean tet edges)")
+                 "How far (m) outside the tets a render vertex may lie (default: two mean tet edges or a tenth of the render mesh's diagonal, the larger)")
       ->check(app::Positive);
   app.add_option("--E", s.mesh.material.youngsModulus, "Young's modulus in Pa (> 0); overrides the mesh file's materials");
   app.add_option("--nu", s.mesh.material.poissonRatio, "Poisson ratio in (-1, 0.5); overrides the mesh file's materials");

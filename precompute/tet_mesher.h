@@ -3,8 +3,9 @@
 // the bake never links it; Debian's `gmsh` package provides it). Gmsh remeshes the surface at the
 // target edge length without a CAD model (ClassifySurfaces / CreateGeometry, as in its tutorial
 // t13), fills it with tets (Delaunay) and optimises them (its own and Netgen's optimisers). The
-// result must reach a floor on the smallest dihedral angle; one more run with stronger
-// optimisation is tried, then the bake stops with the numbers.
+// result must reach a floor on the smallest dihedral angle (neither Gmsh nor TetGen guarantees one:
+// it is measured); two more runs are tried (stronger optimisation, a 2% larger edge), then the bake
+// stops with the numbers. Measured: smooth closed shapes reach 9-19 degrees.
 #include <string>
 
 #include "common/surface_check.h"

@@ -1,6 +1,9 @@
 #include "precompute/stages/surface.h"
 
+#include <algorithm>
 #include <cstdio>
+
+#include <Eigen/Geometry>
 #include <iostream>
 
 #include "common/mesh_error.h"
@@ -37,9 +40,13 @@ RenderInputs bindRenderMesh(const BakeContext& ctx, const std::string& input, co
   out.render = readSurfaceFile(out.path).render;
   if (out.render.triangles.empty())
     throw MeshError(out.path + ": --render-mesh needs a triangle mesh file (OBJ, glTF, STL, PLY, FBX, ...), not a tet mesh");
-  double tolerance = s.embedTolerance;
-  if (!(tolerance > 0)) tolerance = 2 * measureQuality(mesh).edgeLength.mean;  // thin features the tets do not reach
   std::vector<double> points(out.render.positions.begin(), out.render.positions.end());
+  double tolerance = s.embedTolerance;
+  if (!(tolerance > 0)) {  // thin features coarse tets do not reach: two tet edges, or 10% of the mesh's size
+    Eigen::AlignedBox3d box;
+    for (size_t i = 0; i + 2 < points.size(); i += 3) box.extend(Eigen::Vector3d(points[i], points[i + 1], points[i + 2]));
+    tolerance = std::max(2 * measureQuality(mesh).edgeLength.mean, 0.1 * box.diagonal().norm());
+  }
   out.embedding = embedPoints(mesh, points, tolerance, out.path);
   char text[240];
   std::snprintf(text, sizeof text, "render mesh %s: %zu vertices, %zu triangles; %d outside the tets, at most %.3g m (tolerance %.3g m)",

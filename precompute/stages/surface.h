@@ -19,7 +19,7 @@ struct SurfaceSettings {
   MesherSettings mesher;
   SurfaceCheckOptions checks{true};  // holes closed (and said) by default: artists' meshes often have some
   std::string renderMesh;     // --render-mesh; "" : the input when it is a surface, else none
-  double embedTolerance = 0;  // m: how far outside the tets a render vertex may lie; 0: two mean tet edges
+  double embedTolerance = 0;  // m: how far outside the tets a render vertex may lie; 0: two mean tet edges or 10% of its size
 };
 
 // Collective: rank 0 checks and meshes `input` and writes NAME.tets.vtu (every rank throws rank 0's
