@@ -16,11 +16,19 @@ namespace {
 
 using Vec = Eigen::Vector3d;
 
-std::array<double, 4> barycentric(const TetMesh& m, int t, const Vec& p) {
-  const Tet& v = m.tets[t];
-  Eigen::Matrix3d D;
-  for (int k = 0; k < 3; ++k) D.col(k) = m.vertices[v[k + 1]] - m.vertices[v[0]];
-  const Vec b = D.partialPivLu().solve(p - m.vertices[v[0]]);
+// Each tet's inverse edge matrix, once: barycentric weights are then one product.
+std::vector<Eigen::Matrix3d> inverseEdges(const TetMesh& m) {
+  std::vector<Eigen::Matrix3d> out(m.tets.size());
+  for (size_t t = 0; t < m.tets.size(); ++t) {
+    Eigen::Matrix3d D;
+    for (int k = 0; k < 3; ++k) D.col(k) = m.vertices[m.tets[t][k + 1]] - m.vertices[m.tets[t][0]];
+    out[t] = D.inverse();
+  }
+  return out;
+}
+
+std::array<double, 4> barycentric(const TetMesh& m, const std::vector<Eigen::Matrix3d>& inverse, int t, const Vec& p) {
+  const Vec b = inverse[t] * (p - m.vertices[m.tets[t][0]]);
   return {1 - b.sum(), b[0], b[1], b[2]};
 }
 
@@ -75,9 +83,11 @@ Embedding embedPoints(const TetMesh& mesh, const std::vector<double>& points, do
     return std::clamp(static_cast<int>(std::floor((p[a] - all.min()[a]) / cell)), 0, cells[a] - 1);
   };
   std::vector<std::vector<int>> grid(static_cast<size_t>(cells.prod()));
+  const std::vector<Eigen::Matrix3d> inverse = inverseEdges(mesh);
+  std::vector<Eigen::AlignedBox3d> boxes(mesh.tets.size());
   const auto slot = [&](int x, int y, int z) { return (static_cast<size_t>(z) * cells[1] + y) * cells[0] + x; };
   for (int t = 0; t < mesh.tetCount(); ++t) {
-    Eigen::AlignedBox3d box;
+    Eigen::AlignedBox3d& box = boxes[t];
     for (int k = 0; k < 4; ++k) box.extend(mesh.vertices[mesh.tets[t][k]]);
     for (int z = index(box.min(), 2); z <= index(box.max(), 2); ++z)
       for (int y = index(box.min(), 1); y <= index(box.max(), 1); ++y)
@@ -93,19 +103,26 @@ Embedding embedPoints(const TetMesh& mesh, const std::vector<double>& points, do
     int best = -1;
     double bestDistance = std::numeric_limits<double>::infinity(), bestInside = -std::numeric_limits<double>::infinity();
     std::array<double, 4> bestWeights{};
-    const Vec reach = Vec::Constant(tolerance);
-    const Vec lo = p - reach, hi = p + reach;
+    // Shells of cells around p's, nearest first, until no farther shell can hold a nearer tet.
+    const int px = index(p, 0), py = index(p, 1), pz = index(p, 2);
+    const int rings = static_cast<int>(std::ceil(tolerance / cell)) + 1;
+    const auto visit = [&](int x, int y, int z) {
+      if (x < 0 || y < 0 || z < 0 || x >= cells[0] || y >= cells[1] || z >= cells[2]) return;
+      for (int t : grid[slot(x, y, z)]) {
+        if (boxes[t].exteriorDistance(p) > bestDistance) continue;  // cannot be nearer
+        const std::array<double, 4> w = barycentric(mesh, inverse, t, p);
+        const double inside = *std::min_element(w.begin(), w.end());
+        const double distance = inside >= 0 ? 0.0 : (closestOnTet(mesh, t, p, w) - p).norm();
+        if (distance < bestDistance || (distance == 0 && inside > bestInside))
+          best = t, bestDistance = distance, bestInside = inside, bestWeights = w;
+      }
+    };
     if (all.exteriorDistance(p) <= tolerance)
-      for (int z = index(lo, 2); z <= index(hi, 2); ++z)
-        for (int y = index(lo, 1); y <= index(hi, 1); ++y)
-          for (int x = index(lo, 0); x <= index(hi, 0); ++x)
-            for (int t : grid[slot(x, y, z)]) {
-              const std::array<double, 4> w = barycentric(mesh, t, p);
-              const double inside = *std::min_element(w.begin(), w.end());
-              const double distance = inside >= 0 ? 0.0 : (closestOnTet(mesh, t, p, w) - p).norm();
-              if (distance < bestDistance || (distance == 0 && inside > bestInside))
-                best = t, bestDistance = distance, bestInside = inside, bestWeights = w;
-            }
+      for (int k = 0; k <= rings && !(bestDistance < (k - 1) * cell); ++k)
+        for (int z = pz - k; z <= pz + k; ++z)
+          for (int y = py - k; y <= py + k; ++y)
+            for (int x = px - k; x <= px + k; ++x)
+              if (std::max({std::abs(x - px), std::abs(y - py), std::abs(z - pz)}) == k) visit(x, y, z);
     if (best < 0 || bestDistance > tolerance) {
       char text[256];
       if (best < 0)
@@ -120,7 +137,7 @@ Embedding embedPoints(const TetMesh& mesh, const std::vector<double>& points, do
       ++out.outside;
       out.farthest = std::max(out.farthest, bestDistance);
       const bool tame = std::all_of(bestWeights.begin(), bestWeights.end(), [](double w) { return w >= -0.5 && w <= 1.5; });
-      if (!tame) bestWeights = barycentric(mesh, best, closestOnTet(mesh, best, p, bestWeights));
+      if (!tame) bestWeights = barycentric(mesh, inverse, best, closestOnTet(mesh, best, p, bestWeights));
     }
     out.tet[i] = best;
     out.weights[i] = bestWeights;
