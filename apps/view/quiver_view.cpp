@@ -174,6 +174,9 @@ public:
     });
     window.startImGui();
     SurfaceView surface(session_.triangles(), session_.bodyCount() * model_.info().vertex_count);
+    std::optional<SurfaceView> render;  // the render mesh, drawn instead when the model has one
+    if (!session_.renderTriangles().empty())
+      render.emplace(session_.renderTriangles(), session_.bodyCount() * model_.info().render_vertex_count);
     std::optional<SurfaceView> world;  // the colliders, still
     if (!world_.triangles.empty()) {
       world.emplace(world_.triangles, static_cast<int>(world_.positions.size() / 3));
@@ -216,11 +219,17 @@ public:
       glClearColor(0.93f, 0.94f, 0.96f, 1);
       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
       session_.positions(positions_);
-      session_.normals(positions_, normals_);
-      surface.update(positions_, normals_);
       const Eigen::Matrix4f view = camera_.view(), projection = camera_.projection(double(fbWidth) / std::max(fbHeight, 1));
       if (world) world->draw(view, projection, Eigen::Vector3f(0.62f, 0.6f, 0.56f), false);
-      surface.draw(view, projection, Eigen::Vector3f(0.27f, 0.51f, 0.71f), smoothNormals_);
+      if (render && session_.drawsRenderMesh()) {
+        session_.renderSurface(renderPositions_, renderNormals_);
+        render->update(renderPositions_, renderNormals_);
+        render->draw(view, projection, Eigen::Vector3f(0.27f, 0.51f, 0.71f), smoothNormals_);
+      } else {
+        session_.normals(positions_, normals_);
+        surface.update(positions_, normals_);
+        surface.draw(view, projection, Eigen::Vector3f(0.27f, 0.51f, 0.71f), smoothNormals_);
+      }
       if (session_.grabbing()) {
         const int v = session_.grabbedVertex() + session_.grabbedBody() * model_.info().vertex_count;
         const Eigen::Vector3d& t = session_.grabTarget();
@@ -378,7 +387,7 @@ private:
   const char* elasticityLabels_[QV_ELASTICITY_COUNT];
   const char* solverLabels_[QV_SOLVER_COUNT];
   std::string settingsError_;
-  std::vector<float> positions_, normals_;
+  std::vector<float> positions_, normals_, renderPositions_, renderNormals_;
   OrbitCamera camera_;
   TriangleSoup world_;  // the colliders' surfaces
   double size_;

@@ -40,6 +40,21 @@ void ViewSession::startFlight() {
   triangles_.clear();
   for (int k = 0; k < bodyCount(); ++k)
     for (unsigned index : one) triangles_.push_back(index + static_cast<unsigned>(k * model_.info().vertex_count));
+  renderTriangles_.clear();
+  if (!model_.info().render_vertex_count) return;
+  const std::vector<unsigned> render = model_.shownTriangles();
+  for (int k = 0; k < bodyCount(); ++k)
+    for (unsigned index : render) renderTriangles_.push_back(index + static_cast<unsigned>(k * model_.info().render_vertex_count));
+}
+
+void ViewSession::renderSurface(std::vector<float>& positions, std::vector<float>& normals) const {
+  const size_t n = 3 * static_cast<size_t>(model_.info().render_vertex_count);
+  positions.resize(n * bodyCount());
+  normals.resize(positions.size());
+  renderScratch_.resize(qv_model_render_scratch_size(model_.get()) / sizeof(double) + 1);
+  for (int k = 0; k < bodyCount(); ++k)
+    qv_instance_render(flight_ ? flight_->body(k).get() : instance_->get(), positions.data() + n * k, normals.data() + n * k,
+                       renderScratch_.data());
 }
 
 void ViewSession::configure(const ViewSettings& wanted) {

@@ -78,6 +78,12 @@ public:
   const std::vector<unsigned>& triangles() const { return triangles_; }
   void positions(std::vector<float>& out) const;
   void normals(const std::vector<float>& positions, std::vector<float>& out) const;
+  // A model with a render mesh draws it instead while no mode is shown (every body's, one after
+  // the other): its triangles, and its positions and normals now. The mouse still picks the
+  // surface above.
+  bool drawsRenderMesh() const { return model_.info().render_vertex_count > 0 && modeKind_ == ModeKind::None; }
+  const std::vector<unsigned>& renderTriangles() const { return renderTriangles_; }
+  void renderSurface(std::vector<float>& positions, std::vector<float>& normals) const;
   struct Energies {
     double kinetic, elastic;  // J
   };
@@ -105,7 +111,8 @@ private:
   ReducedModes modes_;
   FlightSetup flightSetup_;
   std::unique_ptr<FlightWorld> flight_;  // in flight; body 0 is instance_
-  std::vector<unsigned> triangles_;
+  std::vector<unsigned> triangles_, renderTriangles_;
+  mutable std::vector<double> renderScratch_;  // qv_instance_render's
   double accumulator_ = 0;
   bool behind_ = false;
   int grabbed_ = -1, grabbedBody_ = 0;

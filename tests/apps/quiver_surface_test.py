@@ -8,6 +8,7 @@ public artist's mesh from Debian's assimp-testmodels bakes."""
 import json
 import math
 import os
+import shutil
 import subprocess
 import tempfile
 import unittest
@@ -16,6 +17,8 @@ import numpy as np
 
 BAKE = os.environ["QUIVER_BAKE"]
 QUIVER = os.environ["QUIVER"]
+VIEW = os.environ.get("QUIVER_VIEW", "")
+XVFB_RUN = shutil.which("xvfb-run")
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 HUMAN = "/usr/share/assimp/models/BLEND/HUMAN.blend"
 
@@ -117,6 +120,15 @@ class Surface(unittest.TestCase):
         p = run(MPIEXEC, "-n", 2, "--oversubscribe", BAKE, cls.obj, "--tets", 2000, "--E", "1e5", "--nu", "0.4",
                 "--density", "1000", "--fix", "z<min+0.06", "--modes", 8, "--rank", 16, "--no-fidelity", "-o", cls.name)
         cls.bake_output = p.stdout
+        # The same tets with a finer sphere inside as the render mesh (--render-mesh), and with none.
+        cls.inner_v, cls.inner_uv, cls.inner_tris = uv_sphere(radius=0.35, segments=40, rings=20)
+        inner = os.path.join(cls.tmp.name, "inner.obj")
+        write_obj(inner, cls.inner_v, cls.inner_uv, cls.inner_tris)
+        common = ["--E", "1e5", "--nu", "0.4", "--density", "1000", "--fix", "z<min+0.06", "--modes", 8, "--rank", 16, "--no-fidelity"]
+        cls.inner = os.path.join(cls.tmp.name, "ball_inner")
+        run(BAKE, cls.name + ".tets.vtu", "--render-mesh", inner, *common, "-o", cls.inner)
+        cls.plain = os.path.join(cls.tmp.name, "ball_plain")
+        run(BAKE, cls.name + ".tets.vtu", *common, "-o", cls.plain)
 
     @classmethod
     def tearDownClass(cls):
@@ -154,12 +166,7 @@ class Surface(unittest.TestCase):
     def test_a_render_mesh_inside_moves_as_its_tets(self):
         # --render-mesh: a finer sphere inside the ball, every vertex in some tet. Pulled, each is where
         # the barycentric interpolation of its tet, deformed, puts it (tets found here from the .vtu).
-        v, uv, tris = uv_sphere(radius=0.35, segments=40, rings=20)
-        inner = os.path.join(self.tmp.name, "inner.obj")
-        write_obj(inner, v, uv, tris)
-        name = os.path.join(self.tmp.name, "ball_inner")
-        run(BAKE, self.name + ".tets.vtu", "--render-mesh", inner, "--E", "1e5", "--nu", "0.4", "--density", "1000",
-            "--fix", "z<min+0.06", "--modes", 8, "--rank", 16, "--no-fidelity", "-o", name)
+        v, tris, name = self.inner_v, self.inner_tris, self.inner
         out = os.path.join(self.tmp.name, "pull_inner", "ball")
         run(QUIVER, "sim", name + ".qvr", "--group", "z>max-0.06", "--force", "0,40,0", "--steps", 20, "--hold", 20,
             "-o", out, "--every", 20)
@@ -183,6 +190,26 @@ class Surface(unittest.TestCase):
         print(f"pulled: {len(rest)} render vertices within {worst:.2g} m of their tets' interpolation; moved up to {moved:.3g} m")
         self.assertGreater(moved, 5e-3)
         self.assertLess(worst, 1e-6 + 1e-5 * moved)  # float32 outputs
+
+    @unittest.skipUnless(XVFB_RUN and VIEW, "SKIPPED: xvfb-run (Debian package xvfb) or quiver-view not found")
+    def test_the_viewer_draws_the_render_mesh(self):
+        # The same tets drawn with the finer sphere inside as render mesh cover about (0.35/0.5)^2 of
+        # the pixels they cover without one.
+        import matplotlib.image
+
+        def covered(model, name):
+            path = os.path.join(self.tmp.name, name)
+            p = subprocess.run([XVFB_RUN, "-a", "-s", "-screen 0 1280x1024x24", VIEW, model + ".qvr", "--size", "640,480",
+                                "--no-panel", "--frames", "5", "--screenshot", path], capture_output=True, text=True, timeout=120,
+                               stdin=subprocess.DEVNULL)
+            self.assertEqual(p.returncode, 0, p.stderr)
+            image = matplotlib.image.imread(path)[:, :, :3]
+            return np.count_nonzero(np.abs(image - image[0, 0]).sum(axis=2) > 0.1)
+
+        plain, inner = covered(self.plain, "plain.png"), covered(self.inner, "inner.png")
+        print(f"viewer: {inner} pixels with the inner render mesh, {plain} without one ({inner / plain:.2f}; (0.35/0.5)^2 = 0.49)")
+        self.assertGreater(inner / plain, 0.35)
+        self.assertLess(inner / plain, 0.65)
 
     def bad(self, name, text, *extra):
         path = os.path.join(self.tmp.name, name)
