@@ -52,6 +52,18 @@ TetMesh RuntimeModel::mesh() const {
   return mesh;
 }
 
+RuntimeModel::RenderBasis RuntimeModel::renderBasis() const {
+  const std::string bytes = readFileBytes(path_);
+  ModelView view;
+  std::string error;
+  if (!parseModel(bytes.data(), bytes.size(), view, error)) throw std::runtime_error(path_ + ": " + error);
+  RenderBasis out;
+  out.rows.assign(view.renderBasis, view.renderBasis + 3 * size_t(view.renderVertexCount) * view.info.r);
+  if (view.rigidBody)
+    for (int a = 0; a < 3; ++a) out.centre[a] = view.rigidBody[a];
+  return out;
+}
+
 RuntimeInstance::RuntimeInstance(const RuntimeModel& model, const qv_instance_config& config)
     : model_(model.get()), config_(config), vertexCount_(static_cast<size_t>(model.info().vertex_count)) {
   if (qv_instance_create(model.get(), &config_, nullptr, &instance_) != QV_OK)

@@ -28,6 +28,13 @@ public:
   void positionsAt(const double* q, std::vector<float>& out) const;
   // Rest shape and tets, for vertex selection and .vtu frames.
   TetMesh mesh() const;
+  // The render mesh's basis rows W U (3 x r floats per render vertex), which the runtime does not
+  // keep, from the file, for drawing on the GPU; and a free model's centre of mass as baked.
+  struct RenderBasis {
+    std::vector<float> rows;
+    double centre[3] = {0, 0, 0};
+  };
+  RenderBasis renderBasis() const;
 
 private:
   std::string path_;

@@ -18,12 +18,14 @@
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
+#include <Eigen/Geometry>
 
 #include "apps/render/collider_mesh.h"
 #include "apps/render/software_renderer.h"
 #include "apps/support/mesh_options.h"
 #include "apps/view/drag_script.h"
 #include "apps/view/orbit_camera.h"
+#include "apps/view/render_basis_view.h"
 #include "apps/view/surface_view.h"
 #include "apps/view/view_session.h"
 
@@ -40,6 +42,7 @@ struct ViewOptions {
   std::string screenshot;
   std::string dragScript;
   bool noPanel = false;
+  bool gpuSkinning = false;  // draw the render mesh deformed in the vertex shader (render_basis_view.h)
   std::string showMode;  // "linear:N" or "basis:N": start in the mode browser
   ViewSettings settings;
   FlightSetup flight;    // with --free (settings.step.freeFlight)
@@ -62,6 +65,18 @@ void startBox(const ViewSession& session, Eigen::Vector3d& lo, Eigen::Vector3d& 
   for (size_t v = 0; v < x.size() / 3; ++v)
     for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], double(x[3 * v + a])), hi[a] = std::max(hi[a], double(x[3 * v + a]));
   if (session.flight()) lo[2] -= hi[2] - lo[2];  // and the ground it falls to
+}
+
+// Body coordinates (rest + u) to the world: identity in place; in flight x + R (p - c).
+Eigen::Matrix4f bodyToWorld(const qv_instance* body, const double centre[3]) {
+  Eigen::Matrix4f m = Eigen::Matrix4f::Identity();
+  qv_rigid_state s;
+  if (qv_instance_get_rigid_state(body, &s) != QV_OK) return m;
+  const Eigen::Matrix3d R =
+      Eigen::Quaterniond(s.orientation[0], s.orientation[1], s.orientation[2], s.orientation[3]).normalized().toRotationMatrix();
+  m.topLeftCorner<3, 3>() = R.cast<float>();
+  m.topRightCorner<3, 1>() = (Eigen::Vector3d(s.position) - R * Eigen::Vector3d(centre)).cast<float>();
+  return m;
 }
 
 // The window, its GL context and Dear ImGui, torn down in the right order.
@@ -177,6 +192,15 @@ public:
     std::optional<SurfaceView> render;  // the render mesh, drawn instead when the model has one
     if (!session_.renderTriangles().empty())
       render.emplace(session_.renderTriangles(), session_.bodyCount() * model_.info().render_vertex_count);
+    std::optional<RenderBasisView> gpu;  // --gpu-skinning: one body at a time, deformed in the shader
+    RuntimeModel::RenderBasis basis;
+    if (o_.gpuSkinning) {
+      if (!render) throw std::runtime_error("--gpu-skinning needs a model baked with a render mesh");
+      basis = model_.renderBasis();
+      const float* rest = qv_model_render_rest_positions(model_.get());
+      gpu.emplace(std::vector<float>(rest, rest + 3 * size_t(model_.info().render_vertex_count)), model_.shownTriangles(), basis.rows,
+                  model_.info().r);
+    }
     std::optional<SurfaceView> world;  // the colliders, still
     if (!world_.triangles.empty()) {
       world.emplace(world_.triangles, static_cast<int>(world_.positions.size() / 3));
@@ -221,7 +245,13 @@ public:
       session_.positions(positions_);
       const Eigen::Matrix4f view = camera_.view(), projection = camera_.projection(double(fbWidth) / std::max(fbHeight, 1));
       if (world) world->draw(view, projection, Eigen::Vector3f(0.62f, 0.6f, 0.56f), false);
-      if (render && session_.drawsRenderMesh()) {
+      if (gpu && session_.drawsRenderMesh()) {
+        for (int k = 0; k < session_.bodyCount(); ++k) {
+          std::vector<double> q(static_cast<size_t>(model_.info().r));
+          qv_instance_get_state(session_.body(k), q.data(), nullptr, nullptr);
+          gpu->draw(view, projection, Eigen::Vector3f(0.27f, 0.51f, 0.71f), q, bodyToWorld(session_.body(k), basis.centre));
+        }
+      } else if (render && session_.drawsRenderMesh()) {
         session_.renderSurface(renderPositions_, renderNormals_);
         render->update(renderPositions_, renderNormals_);
         render->draw(view, projection, Eigen::Vector3f(0.27f, 0.51f, 0.71f), smoothNormals_);
@@ -431,6 +461,9 @@ int main(int argc, char** argv) {
   app.add_option("--screenshot", o.screenshot, "With --frames: save the last frame as a PNG");
   app.add_option("--drag-script", o.dragScript, "Drive the mouse from a script (apps/view/drag_script.h)");
   app.add_flag("--no-panel", o.noPanel, "Hide the control panel");
+  app.add_flag("--gpu-skinning", o.gpuSkinning,
+               "Draw the render mesh deformed in the vertex shader from its baked render basis, q uploaded each frame "
+               "(as an engine would; shaded flat)");
   app.add_option("--show-mode", o.showMode, "Start in the mode browser: linear:N (a linear mode) or basis:N (a basis vector)");
   return runTool("quiver-view", app, argc, argv, [&] {
     if (o.size.size() != 2 || o.size[0] < 64 || o.size[1] < 64 || o.size[0] > 8192 || o.size[1] > 8192)

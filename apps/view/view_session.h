@@ -75,6 +75,7 @@ public:
   // their deformed positions (3 floats per vertex: the simulation, or the shown mode) and normals.
   int bodyCount() const { return flight_ ? flight_->bodyCount() : 1; }
   const FlightWorld* flight() const { return flight_.get(); }
+  const qv_instance* body(int k) const { return flight_ ? flight_->body(k).get() : instance_->get(); }
   const std::vector<unsigned>& triangles() const { return triangles_; }
   void positions(std::vector<float>& out) const;
   void normals(const std::vector<float>& positions, std::vector<float>& out) const;

@@ -129,6 +129,9 @@ class Surface(unittest.TestCase):
         run(BAKE, cls.name + ".tets.vtu", "--render-mesh", inner, *common, "-o", cls.inner)
         cls.plain = os.path.join(cls.tmp.name, "ball_plain")
         run(BAKE, cls.name + ".tets.vtu", *common, "-o", cls.plain)
+        cls.free = os.path.join(cls.tmp.name, "ball_free")  # no fixed vertex: it flies
+        run(BAKE, cls.name + ".tets.vtu", "--render-mesh", inner, *[a for a in common if a not in ("--fix", "z<min+0.06")],
+            "-o", cls.free)
 
     @classmethod
     def tearDownClass(cls):
@@ -197,19 +200,28 @@ class Surface(unittest.TestCase):
         # the pixels they cover without one.
         import matplotlib.image
 
-        def covered(model, name):
+        def covered(model, name, *extra):
             path = os.path.join(self.tmp.name, name)
             p = subprocess.run([XVFB_RUN, "-a", "-s", "-screen 0 1280x1024x24", VIEW, model + ".qvr", "--size", "640,480",
-                                "--no-panel", "--frames", "5", "--screenshot", path], capture_output=True, text=True, timeout=120,
+                                "--no-panel", "--screenshot", path, *map(str, extra)], capture_output=True, text=True, timeout=120,
                                stdin=subprocess.DEVNULL)
             self.assertEqual(p.returncode, 0, p.stderr)
             image = matplotlib.image.imread(path)[:, :, :3]
-            return np.count_nonzero(np.abs(image - image[0, 0]).sum(axis=2) > 0.1)
+            return np.abs(image - image[0, 0]).sum(axis=2) > 0.1
 
-        plain, inner = covered(self.plain, "plain.png"), covered(self.inner, "inner.png")
-        print(f"viewer: {inner} pixels with the inner render mesh, {plain} without one ({inner / plain:.2f}; (0.35/0.5)^2 = 0.49)")
-        self.assertGreater(inner / plain, 0.35)
-        self.assertLess(inner / plain, 0.65)
+        plain, inner = covered(self.plain, "plain.png", "--frames", 5), covered(self.inner, "inner.png", "--frames", 5)
+        ratio = inner.sum() / plain.sum()
+        print(f"viewer: {inner.sum()} pixels with the inner render mesh, {plain.sum()} without one ({ratio:.2f}; (0.35/0.5)^2 = 0.49)")
+        self.assertGreater(ratio, 0.35)
+        self.assertLess(ratio, 0.65)
+        # --gpu-skinning (the render basis in the vertex shader) covers the pixels the CPU's output does:
+        # sagging under gravity, and falling in flight onto the ground, turned.
+        for model, args in ((self.inner, ["--frames", 40, "--gravity"]),
+                            (self.free, ["--frames", 40, "--free", "--angular-velocity", "1,2,0"])):
+            cpu = covered(model, "cpu.png", *args)
+            gpu = covered(model, "gpu.png", *args, "--gpu-skinning")
+            print(f"--gpu-skinning {' '.join(map(str, args))}: {np.count_nonzero(cpu != gpu)} of {cpu.sum()} pixels differ")
+            self.assertLess(np.count_nonzero(cpu != gpu), 0.01 * inner.sum())  # 1% of the ball's own pixels
 
     def bad(self, name, text, *extra):
         path = os.path.join(self.tmp.name, name)
