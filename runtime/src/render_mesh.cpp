@@ -89,19 +89,9 @@ void renderOutput(const qv_instance& s, float* positions, float* normals, void* 
   const RenderMesh& mesh = model.render;
   float* u = static_cast<float*>(scratch);  // the simulated vertices' displacements, 3n
   simulatedDisplacements(s, u);
-  const size_t V = static_cast<size_t>(mesh.vertexCount);
-  for (size_t i = 0; i < V; ++i) {
-    const unsigned* v = mesh.tets + 4 * mesh.tetOf[i];
-    const float* w = mesh.weights + 4 * i;
-    for (int a = 0; a < 3; ++a)
-      positions[3 * i + a] = mesh.rest[3 * i + a] + w[0] * u[3 * v[0] + a] + w[1] * u[3 * v[1] + a] + w[2] * u[3 * v[2] + a] +
-                             w[3] * u[3 * v[3] + a];
-  }
-  intoWorld(s, positions, V);
-  if (!normals) return;
-  // cof(F) per tet, F = I + [u1 - u0, u2 - u0, u3 - u0] Dm^-1; then each rest normal through its tet's.
+  // cof(F) per tet, F = I + [u1 - u0, u2 - u0, u3 - u0] Dm^-1 (for the normals).
   float* cofactors = u + 3 * static_cast<size_t>(model.info.vertex_count);
-  for (int t = 0; t < model.info.tet_count; ++t) {
+  for (int t = 0; normals && t < model.info.tet_count; ++t) {
     const unsigned* v = mesh.tets + 4 * t;
     const float* Di = mesh.restInverse + 9 * t;
     float du[9], F[9];
@@ -114,15 +104,26 @@ void renderOutput(const qv_instance& s, float* positions, float* normals, void* 
     C[3] = F[2] * F[7] - F[1] * F[8], C[4] = F[0] * F[8] - F[2] * F[6], C[5] = F[1] * F[6] - F[0] * F[7];
     C[6] = F[1] * F[5] - F[2] * F[4], C[7] = F[2] * F[3] - F[0] * F[5], C[8] = F[0] * F[4] - F[1] * F[3];
   }
+  // One pass over the render vertices: each one's tet read once for its position and its normal.
+  const size_t V = static_cast<size_t>(mesh.vertexCount);
   for (size_t i = 0; i < V; ++i) {
-    const float* C = cofactors + 9 * static_cast<size_t>(mesh.tetOf[i]);
+    const unsigned t = mesh.tetOf[i];
+    const unsigned* v = mesh.tets + 4 * t;
+    const float* w = mesh.weights + 4 * i;
+    for (int a = 0; a < 3; ++a)
+      positions[3 * i + a] = mesh.rest[3 * i + a] + w[0] * u[3 * v[0] + a] + w[1] * u[3 * v[1] + a] + w[2] * u[3 * v[2] + a] +
+                             w[3] * u[3 * v[3] + a];
+    if (!normals) continue;
+    const float* C = cofactors + 9 * static_cast<size_t>(t);
     const float* n0 = mesh.normals + 3 * i;
     float n[3];
     for (int a = 0; a < 3; ++a) n[a] = C[3 * a] * n0[0] + C[3 * a + 1] * n0[1] + C[3 * a + 2] * n0[2];
-    const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    for (int a = 0; a < 3; ++a) normals[3 * i + a] = len > 0 ? n[a] / len : n0[a];
+    const float length2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    const float scale = length2 > 0 ? 1.0f / std::sqrt(length2) : 0.0f;
+    for (int a = 0; a < 3; ++a) normals[3 * i + a] = length2 > 0 ? n[a] * scale : n0[a];
   }
-  directionsIntoWorld(s, normals, V);
+  intoWorld(s, positions, V);
+  if (normals) directionsIntoWorld(s, normals, V);
 }
 
 } // namespace quiver::rt
