@@ -1,24 +1,57 @@
 #!/usr/bin/python3
-"""The runtime's speed for r = 10, 20, 30, 40, 60 on one core, against the core's FMA peak
-measured in the same run. Bakes a 1 x 0.1 x 0.1 cantilever (40 x 4 x 4 cells) at each r, runs
-bench_runtime on the models, prints a markdown table (the one in bench/README.md).
+"""The runtime's speed for r = 10, 20, 30, 40, 60 on one core, against the core's FMA peak and
+against Vega FEM's way of stepping (../shared/tools/vega_like_step.cpp, compiled here at bench time
+with -O3 -march=native, never copied into the project), both measured in the same run on the same
+CPU. Bakes a 1 x 0.1 x 0.1 cantilever (40 x 4 x 4 cells) at each r, runs bench_runtime on the models,
+prints the CPU, the BLAS core the bake's OpenBLAS picks, and a markdown table (the one in bench/README.md).
 
-    /usr/bin/python3 bench/runtime.py --build build/release
+    /usr/bin/python3 bench/runtime.py --build build/release [--shared ../shared]
 """
 import argparse
+import ctypes
 import json
 import os
+import re
+import statistics
 import subprocess
-import sys
 import tempfile
 
 RANKS = (10, 20, 30, 40, 60)
+
+
+def blas_core():
+    """The kernel set Debian's OpenBLAS chose on this CPU (OPENBLAS_CORETYPE overrides it)."""
+    try:
+        lib = ctypes.CDLL("libopenblas.so.0")
+        lib.openblas_get_corename.restype = ctypes.c_char_p
+        return lib.openblas_get_corename().decode()
+    except OSError:
+        return "? (libopenblas.so.0 not found)"
+
+
+def vega_steps(shared, tmp, repetitions):
+    """Median step time (us) of vega_like_step at each r, or {} when ../shared/tools is absent."""
+    source = os.path.join(shared, "tools", "vega_like_step.cpp")
+    if not os.path.exists(source):
+        print(f"(no {source}: the same-run Vega baseline is skipped)")
+        return {}
+    exe = os.path.join(tmp, "vega_like_step")
+    subprocess.run(["g++", "-O3", "-march=native", "-std=c++17", source, "-o", exe], check=True)
+    steps = {}
+    for r in RANKS:
+        times = []
+        for _ in range(repetitions):
+            out = subprocess.run([exe, "--random", str(r), "--vega-like"], check=True, capture_output=True, text=True).stdout
+            times.append(float(re.search(r"step_us=([0-9.eE+-]+)", out).group(1)))
+        steps[r] = statistics.median(times)
+    return steps
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default="build/release")
     ap.add_argument("--repetitions", type=int, default=3)
+    ap.add_argument("--shared", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared"))
     args = ap.parse_args()
     apps = os.path.join(args.build, "apps")
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_pml="ob1")
@@ -36,6 +69,7 @@ def main():
         out = subprocess.run([os.path.join(args.build, "bench", "bench_runtime"), *models, "--benchmark_format=json",
                               f"--benchmark_repetitions={args.repetitions}", "--benchmark_report_aggregates_only=true"],
                              check=True, capture_output=True, text=True).stdout
+        vega = vega_steps(args.shared, tmp, args.repetitions)
     # The median of the repetitions: robust to the odd disturbed run on a shared machine.
     rows = {b["run_name"]: b for b in json.loads(out)["benchmarks"] if b.get("aggregate_name") == "median"}
 
@@ -44,17 +78,18 @@ def main():
     peak = get("PeakFma")
     peak_gflops = peak["GFLOPS"] / 1e9 if peak else float("nan")
     cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")), "?")
-    print(f"CPU: {cpu}")
+    print(f"CPU: {cpu}; OpenBLAS core: {blas_core()}")
     print(f"Peak FMA throughput of this core, measured in the same run: {peak_gflops:.1f} GFLOP/s (AVX-512, double)\n")
-    print("| r | force (us) | force + stiffness (us) | Newmark step, fixed Newton (us) | Newmark step, minimise (us) "
-          "| its Newton iterations | evaluation GFLOP/s | fraction of peak |")
-    print("|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("| r | force (us) | force + stiffness (us) | Newmark step, fixed Newton (us) | Vega-like step, same run (us) "
+          "| x Vega | Newmark step, minimise (us) | its Newton iterations | evaluation GFLOP/s | fraction of peak |")
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for r in RANKS:
         f, fk = get(f"Evaluate/force/r{r}"), get(f"Evaluate/force+stiffness/r{r}")
         newton, minimize = get(f"Step/newton/r{r}"), get(f"Step/minimize/r{r}")
         gflops = fk["GFLOPS"] / 1e9
-        print(f"| {r} | {f['real_time']:.2f} | {fk['real_time']:.2f} | {newton['real_time']:.2f} | "
-              f"{minimize['real_time']:.2f} | {minimize['newton_per_step']:.2f} | {gflops:.1f} | {gflops / peak_gflops:.0%} |")
+        reference = vega.get(r, float("nan"))
+        print(f"| {r} | {f['real_time']:.2f} | {fk['real_time']:.2f} | {newton['real_time']:.2f} | {reference:.1f} | "
+              f"{reference / newton['real_time']:.1f} | {minimize['real_time']:.2f} | {minimize['newton_per_step']:.2f} | {gflops:.1f} | {gflops / peak_gflops:.0%} |")
     for solver in ("newton", "minimize"):
         many = get(f"ManyObjects/{solver}/r20/1000")
         if many:
