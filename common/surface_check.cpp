@@ -191,8 +191,12 @@ CheckedSurface checkSurface(const std::vector<double>& inputPositions, const std
                   open, widest);
     out.repairs.push_back(text);
     countEdges();
-    for (const auto& [e, users] : edges)
-      if (users.size() != 2 && !crowded++) firstCrowded = e;  // a loop through one vertex twice can make one
+    for (const auto& [e, users] : edges) {
+      if (users.size() == 1)
+        fail("a hole could not be closed: an open edge remains between " + where(positions, e.first) + " and " +
+             where(positions, e.second) + "; close the holes in a modelling tool");
+      if (users.size() > 2 && !crowded++) firstCrowded = e;  // a loop through one vertex twice can make one
+    }
   }
   if (crowded)
     fail(std::to_string(crowded) + " edges shared by more than two triangles (non-manifold), the first between " +

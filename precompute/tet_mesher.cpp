@@ -1,5 +1,6 @@
 #include "precompute/tet_mesher.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -28,6 +29,8 @@ constexpr double kTetsPerH3 = 6;
 // A private folder for the run's files, removed with it.
 struct TempFolder {
   fs::path path;
+  TempFolder(const TempFolder&) = delete;
+  TempFolder& operator=(const TempFolder&) = delete;
   TempFolder() {
     std::string pattern = (fs::temp_directory_path() / "quiver-mesher-XXXXXX").string();
     if (!mkdtemp(pattern.data())) throw std::runtime_error("cannot make a temporary folder in " + fs::temp_directory_path().string());
@@ -39,7 +42,8 @@ struct TempFolder {
   }
 };
 
-void writeBinaryStl(const fs::path& path, const CheckedSurface& s) {
+// Float32 coordinates relative to `origin` (the surface's centre: a model far from the origin keeps its precision).
+void writeBinaryStl(const fs::path& path, const CheckedSurface& s, const Eigen::Vector3d& origin) {
   std::ofstream out(path, std::ios::binary);
   char header[80] = "quiver surface";
   out.write(header, sizeof header);
@@ -48,7 +52,7 @@ void writeBinaryStl(const fs::path& path, const CheckedSurface& s) {
   for (const auto& t : s.triangles) {
     float record[12] = {};
     for (int k = 0; k < 3; ++k)
-      for (int a = 0; a < 3; ++a) record[3 + 3 * k + a] = static_cast<float>(s.positions[3 * t[k] + a]);
+      for (int a = 0; a < 3; ++a) record[3 + 3 * k + a] = static_cast<float>(s.positions[3 * t[k] + a] - origin[a]);
     out.write(reinterpret_cast<const char*>(record), sizeof record);
     const uint16_t attribute = 0;
     out.write(reinterpret_cast<const char*>(&attribute), 2);
@@ -99,7 +103,12 @@ MesherResult tetrahedralize(const CheckedSurface& surface, const MesherSettings&
     fail("needs the mesher '" + s.program + "' (Debian package gmsh, which scripts/quiver installs) to make tets of a surface");
   if (!(s.edgeLength > 0) && s.targetTets < 1) fail("--tets must be at least 1");
   TempFolder folder;
-  writeBinaryStl(folder.path / "surface.stl", surface);
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(INFINITY), high = -low;
+  for (const auto& t : surface.triangles)
+    for (int v : t)
+      for (int a = 0; a < 3; ++a) low[a] = std::min(low[a], surface.positions[3 * v + a]), high[a] = std::max(high[a], surface.positions[3 * v + a]);
+  const Eigen::Vector3d origin = 0.5 * (low + high);
+  writeBinaryStl(folder.path / "surface.stl", surface, origin);
   MesherResult result;
   double h = s.edgeLength > 0 ? s.edgeLength : std::cbrt(kTetsPerH3 * surface.volume / s.targetTets);
   const auto start = std::chrono::steady_clock::now();
@@ -110,7 +119,8 @@ MesherResult tetrahedralize(const CheckedSurface& surface, const MesherSettings&
   } passes[] = {{0.7, 1.0}, {0.9, 1.0}, {0.7, 1.02}};
   for (const auto& pass : passes) {
     // A target count gets one correction of h from the first run's count.
-    for (int attempt = 0; attempt < (s.edgeLength > 0 || result.runs ? 1 : 2); ++attempt) {
+    const int attempts = s.edgeLength > 0 || result.runs ? 1 : 2;
+    for (int attempt = 0; attempt < attempts; ++attempt) {
       std::ofstream(folder.path / "surface.geo") << script(h * pass.scale, pass.threshold);
       const std::string command = "cd '" + folder.path.string() + "' && '" + s.program +
                                   "' surface.geo -3 -nt 1 -format msh22 -o tets.msh > gmsh.log 2>&1";
@@ -120,6 +130,7 @@ MesherResult tetrahedralize(const CheckedSurface& surface, const MesherSettings&
         fail("gmsh could not make tets of the surface:" + lastLines(folder.path / "gmsh.log", 3));
       CheckedMesh checked = loadMesh((folder.path / "tets.msh").string());
       result.mesh = std::move(checked.mesh);
+      for (Eigen::Vector3d& x : result.mesh.vertices) x += origin;
       result.mesh.tetRegion.assign(result.mesh.tets.size(), 0);
       result.edgeLength = h * pass.scale;
       fs::remove(folder.path / "tets.msh");

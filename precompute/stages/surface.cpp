@@ -10,6 +10,7 @@
 #include "common/mesh_quality.h"
 #include "common/surface_check.h"
 #include "formats/mesh/write_mesh.h"
+#include "formats/model/qvr.h"
 
 namespace quiver {
 
@@ -37,22 +38,33 @@ RenderInputs bindRenderMesh(const BakeContext& ctx, const std::string& input, co
   RenderInputs out;
   out.path = !s.renderMesh.empty() ? s.renderMesh : isTetMeshPath(input) ? "" : input;
   if (out.path.empty()) return out;
-  out.render = readSurfaceFile(out.path).render;
-  if (out.render.triangles.empty())
-    throw MeshError(out.path + ": --render-mesh needs a triangle mesh file (OBJ, glTF, STL, PLY, FBX, ...), not a tet mesh");
-  std::vector<double> points(out.render.positions.begin(), out.render.positions.end());
-  double tolerance = s.embedTolerance;
-  if (!(tolerance > 0)) {  // thin features coarse tets do not reach: two tet edges, or 10% of the mesh's size
-    Eigen::AlignedBox3d box;
-    for (size_t i = 0; i + 2 < points.size(); i += 3) box.extend(Eigen::Vector3d(points[i], points[i + 1], points[i + 2]));
-    tolerance = std::max(2 * measureQuality(mesh).edgeLength.mean, 0.1 * box.diagonal().norm());
+  // Every rank reads and binds alike; a rank that fails alone (a file missing on its node) makes all fail.
+  std::string error;
+  try {
+    out.render = readSurfaceFile(out.path).render;
+    const size_t vertices = out.render.positions.size() / 3, triangles = out.render.triangles.size() / 3;
+    if (out.render.triangles.empty())
+      throw MeshError(out.path + ": --render-mesh needs a triangle mesh file (OBJ, glTF, STL, PLY, FBX, ...), not a tet mesh");
+    if (vertices < 3 || vertices > qvr::kMaxRenderCount || triangles > qvr::kMaxRenderCount)
+      throw MeshError(out.path + ": " + std::to_string(vertices) + " vertices and " + std::to_string(triangles) +
+                      " triangles: a render mesh holds 3 to 2^26 vertices and at most 2^26 triangles");
+    std::vector<double> points(out.render.positions.begin(), out.render.positions.end());
+    double tolerance = s.embedTolerance;
+    if (!(tolerance > 0)) {  // thin features coarse tets do not reach: two tet edges, or 10% of the mesh's size
+      Eigen::AlignedBox3d box;
+      for (size_t i = 0; i + 2 < points.size(); i += 3) box.extend(Eigen::Vector3d(points[i], points[i + 1], points[i + 2]));
+      tolerance = std::max(2 * measureQuality(mesh).edgeLength.mean, 0.1 * box.diagonal().norm());
+    }
+    out.embedding = embedPoints(mesh, points, tolerance, out.path);
+    char text[240];
+    std::snprintf(text, sizeof text, "render mesh %s: %zu vertices, %zu triangles; %d outside the tets, at most %.3g m (tolerance %.3g m)",
+                  out.path.c_str(), vertices, triangles, out.embedding.outside, out.embedding.farthest, tolerance);
+    ctx.progress(text);
+  } catch (const std::exception& e) {
+    error = e.what();
   }
-  out.embedding = embedPoints(mesh, points, tolerance, out.path);
-  char text[240];
-  std::snprintf(text, sizeof text, "render mesh %s: %zu vertices, %zu triangles; %d outside the tets, at most %.3g m (tolerance %.3g m)",
-                out.path.c_str(), points.size() / 3, out.render.triangles.size() / 3, out.embedding.outside, out.embedding.farthest,
-                tolerance);
-  ctx.progress(text);
+  error = ctx.agreeOnError(error);
+  if (!error.empty()) throw MeshError(error);
   return out;
 }
 

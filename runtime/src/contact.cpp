@@ -209,18 +209,23 @@ int keptOf(const ContactPair& p) {
 }
 
 // Levels for each pair so that its touching candidates fit: the pair that keeps the most gives up its
-// lowest level, until they fit (a patch of a few vertices keeps them all while a face of hundreds
-// thins out).
+// lowest level, until they fit, while that leaves it at least kMinKept (a patch of a few vertices
+// keeps them all while a face of hundreds thins out; levels are spread over the whole surface, so a
+// small patch could otherwise lose every vertex). What still does not fit goes by depth (admit()).
 void keepLevels(ContactList& list) {
+  constexpr int kMinKept = 4;
   int total = list.touching;  // every pair keeps all to begin with
   while (total > list.capacity) {
     ContactPair* richest = nullptr;
-    int most = 1;
-    for (int p = 0; p < list.pairCount; ++p)
-      if (list.pairs[p].minLevel < kContactLevels - 1 && keptOf(list.pairs[p]) > most) richest = &list.pairs[p], most = keptOf(*richest);
+    int most = 0;
+    for (int p = 0; p < list.pairCount; ++p) {
+      ContactPair& pair = list.pairs[p];
+      const int kept = keptOf(pair);
+      if (pair.minLevel < kContactLevels - 1 && kept - pair.count[pair.minLevel] >= kMinKept && kept > most)
+        richest = &pair, most = kept;
+    }
     if (!richest) break;
-    ++richest->minLevel;
-    total += keptOf(*richest) - most;
+    total -= richest->count[richest->minLevel++];
   }
 }
 

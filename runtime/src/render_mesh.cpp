@@ -19,7 +19,9 @@ bool invert3(const double a[9], double out[9]) {
   out[3] = a[5] * a[6] - a[3] * a[8], out[4] = a[0] * a[8] - a[2] * a[6], out[5] = a[2] * a[3] - a[0] * a[5];
   out[6] = a[3] * a[7] - a[4] * a[6], out[7] = a[1] * a[6] - a[0] * a[7], out[8] = a[0] * a[4] - a[1] * a[3];
   const double det = a[0] * out[0] + a[1] * out[3] + a[2] * out[6];
-  if (!(std::fabs(det) > 0)) return false;
+  double scale = 0;  // the largest edge, cubed: a nearly flat tet would make float32 overflow
+  for (int k = 0; k < 9; ++k) scale = std::fmax(scale, std::fabs(a[k]));
+  if (!(std::fabs(det) > 1e-12 * scale * scale * scale)) return false;
   for (int k = 0; k < 9; ++k) out[k] /= det;
   return true;
 }
@@ -75,7 +77,7 @@ void RenderMesh::fill(const ModelView& view, const double* x) {
     double D[9], Di[9];
     for (int a = 0; a < 3; ++a)
       for (int k = 0; k < 3; ++k) D[3 * a + k] = x[3 * v[k + 1] + a] - x[3 * v[0] + a];
-    if (!invert3(D, Di)) std::memset(Di, 0, sizeof Di);  // a flat tet: its vertices' normals stay as at rest
+    if (!invert3(D, Di)) std::memset(Di, 0, sizeof Di);  // a (nearly) flat tet: its vertices' normals stay as at rest
     for (int k = 0; k < 9; ++k) inverse[9 * t + k] = static_cast<float>(Di[k]);
   }
 }
@@ -119,8 +121,9 @@ void renderOutput(const qv_instance& s, float* positions, float* normals, void* 
     float n[3];
     for (int a = 0; a < 3; ++a) n[a] = C[3 * a] * n0[0] + C[3 * a + 1] * n0[1] + C[3 * a + 2] * n0[2];
     const float length2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-    const float scale = length2 > 0 ? 1.0f / std::sqrt(length2) : 0.0f;
-    for (int a = 0; a < 3; ++a) normals[3 * i + a] = length2 > 0 ? n[a] * scale : n0[a];
+    const bool usable = length2 > 0 && std::isfinite(length2);
+    const float scale = usable ? 1.0f / std::sqrt(length2) : 0.0f;
+    for (int a = 0; a < 3; ++a) normals[3 * i + a] = usable ? n[a] * scale : n0[a];
   }
   intoWorld(s, positions, V);
   if (normals) directionsIntoWorld(s, normals, V);
