@@ -1,9 +1,9 @@
 #include "apps/view/render_basis_view.h"
 
-#include <stdexcept>
-#include <string>
 
 #include <epoxy/gl.h>
+
+#include "apps/view/gl_program.h"
 
 namespace quiver::app {
 
@@ -20,6 +20,7 @@ uniform mat4 bodyToWorld;
 uniform mat4 view;
 uniform mat4 projection;
 out vec3 viewPosition;
+out vec3 viewNormal;  // unused: shaded flat
 void main() {
   vec3 u = vec3(0.0);
   int row = 3 * r * gl_VertexID;
@@ -27,55 +28,18 @@ void main() {
     u += q[j] * vec3(texelFetch(basis, row + j).r, texelFetch(basis, row + r + j).r, texelFetch(basis, row + 2 * r + j).r);
   vec4 p = view * (bodyToWorld * vec4(rest + u, 1.0));
   viewPosition = p.xyz;
+  viewNormal = vec3(0.0, 0.0, 1.0);
   gl_Position = projection * p;
 }
 )";
 
-const char* kFragmentShader = R"(#version 330 core
-in vec3 viewPosition;
-uniform vec3 colour;
-out vec4 fragment;
-void main() {
-  vec3 toEye = normalize(-viewPosition);
-  vec3 n = normalize(cross(dFdx(viewPosition), dFdy(viewPosition)));
-  if (dot(n, toEye) < 0.0) n = -n;
-  vec3 key = normalize(vec3(-0.4, 0.8, 0.6));
-  float diffuse = 0.55 * max(dot(n, toEye), 0.0) + 0.35 * max(dot(n, key), 0.0);
-  float specular = 0.25 * pow(max(dot(n, normalize(key + toEye)), 0.0), 40.0);
-  fragment = vec4(colour * (0.22 + diffuse) + vec3(specular), 1.0);
-}
-)";
-
-unsigned compile(GLenum kind, const char* source) {
-  const unsigned shader = glCreateShader(kind);
-  glShaderSource(shader, 1, &source, nullptr);
-  glCompileShader(shader);
-  int ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = "";
-    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
-    glDeleteShader(shader);
-    throw std::runtime_error(std::string("OpenGL shader does not compile: ") + log);
-  }
-  return shader;
-}
 
 } // namespace
 
 RenderBasisView::RenderBasisView(const std::vector<float>& rest, const std::vector<unsigned>& triangles,
                                  const std::vector<float>& rows, int r)
     : indexCount_(static_cast<int>(triangles.size())), r_(r) {
-  const unsigned vs = compile(GL_VERTEX_SHADER, kVertexShader), fs = compile(GL_FRAGMENT_SHADER, kFragmentShader);
-  program_ = glCreateProgram();
-  glAttachShader(program_, vs);
-  glAttachShader(program_, fs);
-  glLinkProgram(program_);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  int ok = 0;
-  glGetProgramiv(program_, GL_LINK_STATUS, &ok);
-  if (!ok) throw std::runtime_error("OpenGL shader program does not link");
+  program_ = buildSurfaceProgram(kVertexShader);
   glGenVertexArrays(1, &array_);
   glBindVertexArray(array_);
   glGenBuffers(1, &rest_);
@@ -113,6 +77,8 @@ void RenderBasisView::draw(const Eigen::Matrix4f& view, const Eigen::Matrix4f& p
   glUniformMatrix4fv(glGetUniformLocation(program_, "projection"), 1, GL_FALSE, projection.data());
   glUniformMatrix4fv(glGetUniformLocation(program_, "bodyToWorld"), 1, GL_FALSE, bodyToWorld.data());
   glUniform3fv(glGetUniformLocation(program_, "colour"), 1, colour.data());
+  glUniform1i(glGetUniformLocation(program_, "lit"), 1);
+  glUniform1i(glGetUniformLocation(program_, "smoothNormals"), 0);
   glUniform1i(glGetUniformLocation(program_, "r"), r_);
   glUniform1fv(glGetUniformLocation(program_, "q"), r_, qf.data());
   glActiveTexture(GL_TEXTURE0);

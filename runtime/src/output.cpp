@@ -70,17 +70,8 @@ void displacements(const qv_model& m, const double* q, float* out) {
 
 void positions(const qv_instance& s, float* out) {
   const qv_model& m = *s.model;
-  if (s.config.elasticity != QV_ELASTICITY_MODAL_WARPING) {
-    displacements(m, s.q, out);
-    for (size_t i = 0; i < 3 * static_cast<size_t>(m.info.vertex_count); ++i)
-      out[i] = static_cast<float>(m.rest[i] + out[i]);
-  } else {
-    for (int v = 0; v < m.info.vertex_count; ++v) {
-      double u[3];
-      vertexDisplacement(s, v, u);
-      for (int c = 0; c < 3; ++c) out[3 * v + c] = static_cast<float>(m.rest[3 * v + c] + u[c]);
-    }
-  }
+  simulatedDisplacements(s, out);
+  for (size_t i = 0; i < 3 * static_cast<size_t>(m.info.vertex_count); ++i) out[i] = static_cast<float>(m.rest[i] + out[i]);
   intoWorld(s, out, static_cast<size_t>(m.info.vertex_count));
 }
 
@@ -93,10 +84,10 @@ void positionsOf(const qv_instance& s, const int* vertices, int count, float* ou
   intoWorld(s, out, static_cast<size_t>(count));
 }
 
-void surfaceNormals(const qv_model& m, const float* p, float* normals) {
-  std::memset(normals, 0, sizeof(float) * 3 * static_cast<size_t>(m.info.vertex_count));
-  for (int t = 0; t < m.info.triangle_count; ++t) {
-    const unsigned* v = m.triangles + 3 * t;
+void areaWeightedNormals(const float* p, const unsigned* triangles, int triangleCount, int vertexCount, float* normals) {
+  std::memset(normals, 0, sizeof(float) * 3 * static_cast<size_t>(vertexCount));
+  for (int t = 0; t < triangleCount; ++t) {
+    const unsigned* v = triangles + 3 * t;
     const float* a = p + 3 * v[0];
     const float* b = p + 3 * v[1];
     const float* c = p + 3 * v[2];
@@ -105,12 +96,16 @@ void surfaceNormals(const qv_model& m, const float* p, float* normals) {
     for (int k = 0; k < 3; ++k)
       for (int c2 = 0; c2 < 3; ++c2) normals[3 * v[k] + c2] += n[c2];  // area-weighted: |n| = 2 x area
   }
-  for (int i = 0; i < m.info.vertex_count; ++i) {
+  for (int i = 0; i < vertexCount; ++i) {
     float* n = normals + 3 * i;
     const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (len > 0)
       for (int c = 0; c < 3; ++c) n[c] /= len;
   }
+}
+
+void surfaceNormals(const qv_model& m, const float* p, float* normals) {
+  areaWeightedNormals(p, m.triangles, m.info.triangle_count, m.info.vertex_count, normals);
 }
 
 } // namespace quiver::rt

@@ -13,5 +13,7 @@ void directionsIntoWorld(const qv_instance& s, float* directions, size_t count);
 void positions(const qv_instance& s, float* out);                                  // all vertices
 void positionsOf(const qv_instance& s, const int* vertices, int count, float* out);  // the listed ones
 void surfaceNormals(const qv_model& model, const float* positions, float* normals);
+// Unit normals of the triangles' vertices, area-weighted; 0 for vertices no triangle has.
+void areaWeightedNormals(const float* positions, const unsigned* triangles, int triangleCount, int vertexCount, float* normals);
 
 } // namespace quiver::rt

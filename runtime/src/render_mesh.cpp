@@ -55,17 +55,9 @@ void RenderMesh::fill(const ModelView& view, const double* x) {
   if (view.renderNormals) {
     std::memcpy(n, view.renderNormals, 12 * V);
   } else {  // area-weighted from the rest triangles
-    std::memset(n, 0, 12 * V);
-    for (size_t t = 0; t < T; ++t) {
-      const unsigned* v = triangles + 3 * t;
-      const float *a = rest + 3 * v[0], *b = rest + 3 * v[1], *c = rest + 3 * v[2];
-      const float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-      const float f[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-      for (int k = 0; k < 3; ++k)
-        for (int a2 = 0; a2 < 3; ++a2) n[3 * v[k] + a2] += f[a2];
-    }
+    areaWeightedNormals(rest, triangles, triangleCount, vertexCount, n);
   }
-  for (size_t i = 0; i < V; ++i) {
+  for (size_t i = 0; i < V; ++i) {  // unit length; +z where a vertex has none
     float* ni = n + 3 * i;
     const float len = std::sqrt(ni[0] * ni[0] + ni[1] * ni[1] + ni[2] * ni[2]);
     for (int a = 0; a < 3; ++a) ni[a] = len > 0 ? ni[a] / len : (a == 2 ? 1.0f : 0.0f);
