@@ -3,7 +3,10 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
+#include <sstream>
+#include <string_view>
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -23,6 +26,35 @@ SurfaceMesh tetBoundary(const std::string& path) {
   for (const Eigen::Vector3d& x : checked.mesh.vertices) s.positions.insert(s.positions.end(), {x[0], x[1], x[2]});
   for (const auto& t : boundaryTriangles(checked.mesh)) s.triangles.insert(s.triangles.end(), {t[0], t[1], t[2]});
   return s;
+}
+
+// Assimp's OFF and PLY importers allocate what their headers count before reading on: a few
+// corrupt bytes ("OFF 8 611111111111") would ask for gigabytes. Counts a file of this size cannot
+// hold are refused here first (an element takes at least one byte; an OFF vertex at least 6).
+void checkHeaderCounts(std::string_view bytes, const std::string& extension, const std::string& name) {
+  std::string ext = extension;
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const auto refuse = [&](const std::string& what) {
+    throw MeshError(name + ": the header counts " + what + ", more than its " + std::to_string(bytes.size()) + " bytes can hold");
+  };
+  std::istringstream in(std::string(bytes.substr(0, 65536)));
+  std::string word;
+  if (ext == "off") {
+    double vertices = 0, faces = 0;  // after OFF (or COFF, NOFF, ...); anything else the importer judges
+    if (!(in >> word) || word.find("OFF") == std::string::npos || !(in >> vertices >> faces)) return;
+    if (6 * vertices + faces > double(bytes.size()))
+      refuse(std::to_string(static_cast<long long>(std::fmin(vertices, 9e18))) + " vertices and " +
+             std::to_string(static_cast<long long>(std::fmin(faces, 9e18))) + " faces");
+  } else if (ext == "ply") {
+    double total = 0;
+    for (std::string line; std::getline(in, line) && line.rfind("end_header", 0) != 0;) {
+      std::istringstream fields(line);
+      std::string keyword, element;
+      double count = 0;
+      if (fields >> keyword >> element >> count && keyword == "element" && count > 0) total += count;
+    }
+    if (total > double(bytes.size())) refuse(std::to_string(static_cast<long long>(std::fmin(total, 9e18))) + " elements");
+  }
 }
 
 // Points and lines are dropped by the importer; what remains is triangles, checked.
@@ -89,12 +121,20 @@ bool isTetMeshPath(const std::string& path) {
 SurfaceMesh readSurfaceFile(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw MeshError(path + ": cannot open: no such file");
   if (isTetMeshPath(path)) return tetBoundary(path);
+  std::string extension = std::filesystem::path(path).extension().string();
+  if (!extension.empty()) extension.erase(0, 1);
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == "off" || extension == "ply") {
+    std::ifstream in(path, std::ios::binary);
+    checkHeaderCounts(std::string((std::istreambuf_iterator<char>(in)), {}), extension, path);
+  }
   Assimp::Importer importer;
   configure(importer);
   return fromScene(importer.ReadFile(path, kSteps), importer, path);
 }
 
 SurfaceMesh readSurfaceMemory(const void* data, size_t size, const std::string& extension, const std::string& name) {
+  checkHeaderCounts(std::string_view(static_cast<const char*>(data), size), extension, name);
   Assimp::Importer importer;
   configure(importer);
   return fromScene(importer.ReadFileFromMemory(data, size, kSteps, extension.c_str()), importer, name);

@@ -59,5 +59,20 @@ TEST(ReadSurface, WhatIsNotASurfaceIsNamed) {
   EXPECT_THROW(readSurfaceFile("/nonexistent/x.obj"), MeshError);
 }
 
+TEST(ReadSurface, HeaderCountsTheFileCannotHoldAreRefusedBeforeAssimpAllocatesThem) {
+  // Found by fuzz.surface: Assimp's OFF importer allocated the 7.7e12 faces this header claims.
+  const std::string off = "OFF\n4 7777777777776 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n";
+  const std::string ply = "ply\nformat ascii 1.0\nelement vertex 99999999999\nproperty float x\nend_header\n0\n";
+  for (const auto& [bytes, format] : {std::pair{off, "off"}, std::pair{ply, "ply"}}) {
+    try {
+      readSurfaceMemory(bytes.data(), bytes.size(), format, std::string("bad.") + format);
+      ADD_FAILURE() << format << " read";
+    } catch (const MeshError& e) {
+      EXPECT_NE(std::string(e.what()).find("more than its " + std::to_string(bytes.size()) + " bytes can hold"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 } // namespace
 } // namespace quiver
