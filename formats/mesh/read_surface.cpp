@@ -3,7 +3,6 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <sstream>
 #include <string_view>
@@ -124,10 +123,7 @@ SurfaceMesh readSurfaceFile(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
   if (!extension.empty()) extension.erase(0, 1);
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (extension == "off" || extension == "ply") {
-    std::ifstream in(path, std::ios::binary);
-    checkHeaderCounts(std::string((std::istreambuf_iterator<char>(in)), {}), extension, path);
-  }
+  if (extension == "off" || extension == "ply") checkHeaderCounts(readFileBytes(path), extension, path);
   Assimp::Importer importer;
   configure(importer);
   return fromScene(importer.ReadFile(path, kSteps), importer, path);

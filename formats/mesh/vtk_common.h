@@ -15,6 +15,7 @@
 
 namespace quiver::vtk {
 
+constexpr int64_t kTriangle = 5;  // VTK_TRIANGLE
 constexpr int64_t kTetra = 10;  // VTK_TETRA
 
 enum class Scalar { Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, Float32, Float64 };

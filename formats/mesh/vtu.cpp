@@ -505,7 +505,7 @@ std::string formatTriangleVtu(const std::vector<float>& positions, const std::ve
   for (size_t c = 1; c <= cells; ++c) offsets.push_back(static_cast<int64_t>(3 * c));
   w.dataArray("Int64", "connectivity", 1, connectivity);
   w.dataArray("Int64", "offsets", 1, offsets);
-  w.dataArray("UInt8", "types", 1, std::vector<uint8_t>(cells, static_cast<uint8_t>(5)));  // VTK_TRIANGLE
+  w.dataArray("UInt8", "types", 1, std::vector<uint8_t>(cells, static_cast<uint8_t>(vtk::kTriangle)));
   w.xml += "      </Cells>\n    </Piece>\n";
   return w.finish();
 }

@@ -5,28 +5,20 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "common/mesh_error.h"
 #include "common/surface_check.h"
+#include "formats/mesh/read_mesh.h"
 #include "formats/mesh/read_surface.h"
 #include "tests/support/test_support.h"
 
 namespace quiver {
 namespace {
 
-std::string bytesOf(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 TEST(ReadSurface, TheSeedCubeReadsAlikeInEveryFormat) {
   const char* const formats[] = {"obj", "stl", "ply", "off", "gltf", "glb"};
   for (const char* name : {"cube.obj", "cube_ascii.stl", "cube_binary.stl", "cube.ply", "cube.off"}) {
-    const std::string bytes = bytesOf(test::asset(std::string("../fuzz/seeds/surface/") + name));
+    const std::string bytes = readFileBytes(test::asset(std::string("../fuzz/seeds/surface/") + name));
     ASSERT_FALSE(bytes.empty()) << name;
     const SurfaceMesh s = readSurfaceMemory(bytes.data() + 1, bytes.size() - 1, formats[bytes[0] % 6], name);
     EXPECT_EQ(s.positions.size(), 24u) << name;
