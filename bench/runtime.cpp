@@ -1,7 +1,8 @@
 // The runtime's hot paths on baked models, single thread (Google Benchmark):
 //   Evaluate/force, Evaluate/force+stiffness, Step/newton (implicit Newmark, Barbic & James's one
 //   Newton iteration), Step/minimize (the default solver), both under a load that keeps the object
-//   moving, and ManyObjects: 1000 instances of one model under gravity stepped per frame (both solvers).
+//   moving, and ManyObjects: 1000 instances of one model stepped per frame (both solvers, one by one
+//   and in one qv_instances_step call).
 // Peak FMA throughput of this core is measured in the same run (PeakFma) so that the evaluation
 // can be reported as a fraction of it. Each benchmark's label carries a hash of its final state.
 //   bench/runtime.py --build build/release     (bakes the models, runs this, prints the table)
@@ -10,6 +11,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -123,24 +125,43 @@ void Step(benchmark::State& state, const char* path, qv_solver solver) {
   qv_model_destroy(m.model);
 }
 
-void ManyObjects(benchmark::State& state, const char* path, qv_solver solver) {
+// `objects` instances of one model per frame, each under its own push on the first coordinate (0.1
+// to 0.2 times what gravity puts there, flipping every half second, out of phase from one instance
+// to the next: about 0.1 to 0.3 m at the tip of the 1 m bar), stepped one
+// by one (qv_instance_step) or in one call (qv_instances_step: groups of 8 evaluated together).
+void ManyObjects(benchmark::State& state, const char* path, qv_solver solver, bool together) {
   Loaded m(path);
-  const int objects = static_cast<int>(state.range(0));
+  const int objects = static_cast<int>(state.range(0)), r = m.info.r;
   qv_instance_config config;
   qv_instance_config_init(&config, m.model);
   config.solver = solver;
   if (solver == QV_SOLVER_NEWTON) config.newton_iterations = 1;
   std::vector<qv_instance*> all(objects);
-  const double g[3] = {0, 0, -QV_STANDARD_GRAVITY};
-  for (auto& s : all) {
-    qv_instance_create(m.model, &config, nullptr, &s);
-    qv_instance_set_gravity(s, g);
+  for (auto& s : all) qv_instance_create(m.model, &config, nullptr, &s);
+  const size_t bytes = qv_instances_step_scratch_size(m.model, 1);
+  void* scratch = std::aligned_alloc(64, (bytes + 63) / 64 * 64);
+  const double amplitude = 0.1 * QV_STANDARD_GRAVITY * std::fabs(qv_model_gravity(m.model)[2 * r]);
+  std::vector<double> push(r, 0.0);
+  std::vector<qv_step_status> statuses(objects);
+  long frame = 0, resets = 0;
+  for (auto _ : state) {
+    for (int i = 0; i < objects; ++i) {
+      push[0] = (1 + (i % 11) / 10.0) * (((frame + i) / 30) % 2 ? amplitude : -amplitude);
+      qv_instance_add_reduced_force(all[i], push.data());
+    }
+    if (together) {
+      qv_instances_step(all.data(), objects, nullptr, scratch, bytes, statuses.data());
+      for (qv_step_status status : statuses) resets += status == QV_STEP_RESET;
+    } else {
+      for (auto* s : all) resets += qv_instance_step(s) == QV_STEP_RESET;
+    }
+    ++frame;
   }
-  for (auto _ : state)
-    for (auto* s : all) qv_instance_step(s);
-  state.counters["r"] = m.info.r;
+  state.counters["r"] = r;
   state.counters["frame_ms"] = benchmark::Counter(1e3 * state.iterations(), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
-  state.SetLabel("state " + stateHash(all.back(), m.info.r));
+  state.counters["resets"] = static_cast<double>(resets);  // expected 0: a reset step is no measure
+  state.SetLabel("state " + stateHash(all.back(), r));
+  std::free(scratch);
   for (auto* s : all) qv_instance_destroy(s);
   qv_model_destroy(m.model);
 }
@@ -159,12 +180,14 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark(("Evaluate/force+stiffness" + r).c_str(), Evaluate, path, true)->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("Step/newton" + r).c_str(), Step, path, QV_SOLVER_NEWTON)->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("Step/minimize" + r).c_str(), Step, path, QV_SOLVER_MINIMIZE)->Unit(benchmark::kMicrosecond);
-    if (probe.info.r == 20)
+    if (probe.info.r == 20 || probe.info.r == 30)
       for (qv_solver solver : {QV_SOLVER_NEWTON, QV_SOLVER_MINIMIZE})
-        benchmark::RegisterBenchmark(("ManyObjects/" + std::string(qv_solver_name(solver)) + r).c_str(), ManyObjects, path,
-                                     solver)
-            ->Arg(1000)
-            ->Unit(benchmark::kMillisecond);
+        for (bool together : {false, true})
+          benchmark::RegisterBenchmark(("ManyObjects/" + std::string(qv_solver_name(solver)) +
+                                        (together ? "/together" : "/one-by-one") + r).c_str(),
+                                       ManyObjects, path, solver, together)
+              ->Arg(1000)
+              ->Unit(benchmark::kMillisecond);
   }
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

@@ -16,6 +16,7 @@
 #include "model.h"
 #include "output.h"
 #include "render_mesh.h"
+#include "step_many.h"
 #include "triangle_mesh.h"
 #include "world.h"
 #include "quiver/quiver.h"
@@ -257,6 +258,49 @@ void qv_instance_destroy(qv_instance* s) {
 }
 
 qv_step_status qv_instance_step(qv_instance* s) { return s->step(); }
+
+size_t qv_instances_step_scratch_size(const qv_model* model, int jobs) {
+  return model && jobs >= 1 ? quiver::rt::stepManyScratchPerJob(*model) * static_cast<size_t>(jobs) : 0;
+}
+
+namespace {
+
+struct StepManyWork {
+  qv_instance* const* instances;
+  int count;
+  int jobs;
+  char* scratch;
+  size_t scratchPerJob;
+  qv_step_status* statuses;
+};
+
+void stepManyJob(void* data, int job) {
+  const StepManyWork& w = *static_cast<const StepManyWork*>(data);
+  if (job < 0 || job >= w.jobs) return;
+  const auto bound = [&](int j) { return static_cast<int>(static_cast<long long>(w.count) * j / w.jobs); };
+  quiver::rt::stepManyRange(w.instances, bound(job), bound(job + 1), w.scratch + w.scratchPerJob * job, w.statuses);
+}
+
+} // namespace
+
+qv_result qv_instances_step(qv_instance* const* instances, int count, const qv_job_runner* jobs, void* scratch,
+                            size_t scratchSize, qv_step_status* statuses) {
+  if (count < 0 || (count > 0 && !instances) || (jobs && (jobs->count < 1 || !jobs->run)))
+    return QV_ERROR_INVALID_ARGUMENT;
+  if (count == 0) return QV_OK;
+  for (int i = 0; i < count; ++i)
+    if (!instances[i] || instances[i]->model != instances[0]->model) return QV_ERROR_INVALID_ARGUMENT;
+  const int jobCount = jobs ? jobs->count : 1;
+  const size_t perJob = quiver::rt::stepManyScratchPerJob(*instances[0]->model);
+  if (!scratch || reinterpret_cast<uintptr_t>(scratch) % 64 != 0 || scratchSize / perJob < static_cast<size_t>(jobCount))
+    return QV_ERROR_INVALID_ARGUMENT;
+  StepManyWork work{instances, count, jobCount, static_cast<char*>(scratch), perJob, statuses};
+  if (jobs)
+    jobs->run(jobs->user, stepManyJob, &work, jobCount);
+  else
+    stepManyJob(&work, 0);
+  return QV_OK;
+}
 
 void qv_instance_last_step(const qv_instance* s, qv_step_report* report) {
   if (s && report) *report = s->lastStep;

@@ -7,30 +7,33 @@
 
 namespace quiver::rt {
 
-// Solves A x = b for symmetric positive definite A (row-major, n x n; overwritten by its factor).
-// b is overwritten by x. Returns false, leaving A and b spoiled, when A is not positive definite.
+// Solves A x = b for symmetric positive definite A (row-major, n x n; only its upper triangle is
+// read, and it is overwritten by the factor U of A = U^T U). b is overwritten by x. Returns false,
+// leaving A and b spoiled, when A is not positive definite. Right-looking, row by row: every inner
+// loop is an axpy along a row, which vectorises without reordering any sum.
 inline bool choleskySolve(double* A, double* b, int n) {
   for (int j = 0; j < n; ++j) {
-    double d = A[j * n + j];
-    for (int k = 0; k < j; ++k) d -= A[j * n + k] * A[j * n + k];
-    if (!(d > 0)) return false;
-    const double l = std::sqrt(d);
-    A[j * n + j] = l;
+    double* rowJ = A + j * n;
+    if (!(rowJ[j] > 0)) return false;
+    const double u = std::sqrt(rowJ[j]), inverse = 1 / u;
+    rowJ[j] = u;
+    for (int k = j + 1; k < n; ++k) rowJ[k] *= inverse;
     for (int i = j + 1; i < n; ++i) {
-      double s = A[i * n + j];
-      for (int k = 0; k < j; ++k) s -= A[i * n + k] * A[j * n + k];
-      A[i * n + j] = s / l;
+      double* rowI = A + i * n;
+      const double f = rowJ[i];
+      for (int k = i; k < n; ++k) rowI[k] -= f * rowJ[k];
     }
   }
-  for (int i = 0; i < n; ++i) {  // L y = b
-    double s = b[i];
-    for (int k = 0; k < i; ++k) s -= A[i * n + k] * b[k];
-    b[i] = s / A[i * n + i];
+  for (int i = 0; i < n; ++i) {  // U^T y = b
+    const double* rowI = A + i * n;
+    b[i] /= rowI[i];
+    for (int k = i + 1; k < n; ++k) b[k] -= rowI[k] * b[i];
   }
-  for (int i = n - 1; i >= 0; --i) {  // L^T x = y
+  for (int i = n - 1; i >= 0; --i) {  // U x = y
+    const double* rowI = A + i * n;
     double s = b[i];
-    for (int k = i + 1; k < n; ++k) s -= A[k * n + i] * b[k];
-    b[i] = s / A[i * n + i];
+    for (int k = i + 1; k < n; ++k) s -= rowI[k] * b[k];
+    b[i] = s / rowI[i];
   }
   return true;
 }

@@ -7,6 +7,11 @@
 
 namespace quiver::rt {
 
+// E(q) (when `energy` is not null), R(q) into `force` and K(q) into s.work.stiffness: the
+// group's preset when it was evaluated at exactly q (the step's first guess, step_many.h), else
+// evaluated now.
+void elasticityAt(qv_instance& s, const double* q, double* energy, double* force);
+
 // Fills s.work.force = R(q) + S(q) and s.work.stiffness = K(q); returns J.
 const double* evaluateForces(qv_instance& s, const double* q);
 

@@ -117,6 +117,8 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
   work.stateForceSink = c.take<double>(r);
   work.pivot = c.take<int>(r);
   work.polynomialScratch = c.take<double>(quiver::rt::ReducedPolynomial::scratchSize(r));
+  work.presetAt = c.take<double>(r);
+  work.presetForce = c.take<double>(r);
   if (flying()) {
     frame.attach(c.take<double>(quiver::rt::RigidFrame::scratchDoubles(r)), r);
     contacts.contacts = c.take<quiver::rt::Contact>(static_cast<size_t>(config.max_contacts));
@@ -203,6 +205,7 @@ void qv_instance::solveOwnContacts() {
 qv_step_status qv_instance::finishStep() {
   if (flying()) frame.move(config.time_step);
   const qv_step_status status = quiver::rt::kIntegrators[config.integrator].step(*this);
+  work.presetValid = false;
   loads.endStep();
   if (status == QV_STEP_RESET || !healthy()) {
     rest();

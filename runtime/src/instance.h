@@ -33,6 +33,13 @@ struct StepBuffers {
   double* stateForceSink = nullptr;    // where stepEnergy() lets the state forces add the force it does not need
   int* pivot = nullptr;           // LU's row exchanges
   double* polynomialScratch = nullptr;
+  // A group stepped together (step_many.h) evaluates each member's polynomial at its step's first
+  // guess before the steps: R(q) and E(q) here, K(q) in `stiffness`. The step's first elastic
+  // evaluation takes them when it is at exactly that point (elasticityAt(), dynamics.h).
+  double* presetAt = nullptr;
+  double* presetForce = nullptr;
+  double presetEnergy = 0;
+  bool presetValid = false;
 };
 
 // Bytes of the block an instance with `config` needs (64-byte aligned).

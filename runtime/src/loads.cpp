@@ -33,7 +33,7 @@ void Loads::clear() {
 
 const double* Loads::addStateForces(const double* q, double* force, double* energy) const {
   double potential = 0;  // q^T Kc q / 2 - bc^T q
-  for (int i = 0; i < r; ++i) {
+  for (int i = 0; i < r && constrained; ++i) {
     double s = -constraintB[i];
     for (int j = 0; j < r; ++j) s += constraintK[i * r + j] * q[j];
     force[i] += s;
@@ -116,8 +116,10 @@ void Loads::combineConstraints() {
   const size_t rr = static_cast<size_t>(r) * r;
   std::memset(constraintK, 0, sizeof(double) * rr);
   std::memset(constraintB, 0, sizeof(double) * r);
+  constrained = false;
   for (int s = 0; s < slots; ++s) {
     if (!slotActive[s]) continue;
+    constrained = true;
     for (size_t k = 0; k < rr; ++k) constraintK[k] += slotK[s * rr + k];
     for (int i = 0; i < r; ++i) constraintB[i] += slotB[s * r + i];
   }

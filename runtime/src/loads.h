@@ -32,6 +32,7 @@ struct Loads {
   double* slotK = nullptr;         // per slot
   double* slotB = nullptr;
   int* slotActive = nullptr;
+  bool constrained = false;        // some slot is active (else the constraint sums are zero)
   double* lastStepForce = nullptr; // the per-step forces of the step before
   bool changed = false;            // a persistent load was set since the last step
   const RigidFrame* frame = nullptr;  // in flight: its centrifugal potential is a state force

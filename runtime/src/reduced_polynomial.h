@@ -31,6 +31,17 @@ public:
   // Any of energy, force (r) and stiffness (r x r, row-major) may be null. `scratch`: scratchSize(r) doubles.
   void evaluate(const double* q, double* energy, double* force, double* stiffness, double* scratch) const;
 
+  // The same for up to kLanes states at once (reduced_polynomial_lanes.cpp): each coefficient is
+  // read once for all of them and multiplies a vector of kLanes values, one per state, so a group
+  // costs about what one state costs with the coefficients in L1. Entry i of q, energy, force and
+  // stiffness belongs to state i < count (none may be null). The sums run in another order than
+  // evaluate()'s, so results agree with it to rounding, not bit for bit. `scratch`:
+  // laneScratchSize(r) doubles, 64-byte aligned.
+  static constexpr int kLanes = 8;
+  static size_t laneScratchSize(int r);
+  void evaluateLanes(const double* const* q, int count, double* energy, double* const* force,
+                     double* const* stiffness, double* scratch) const;
+
   int r() const { return r_; }
   bool single() const { return q32_ != nullptr; }
 

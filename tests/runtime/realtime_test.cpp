@@ -84,6 +84,29 @@ TEST(RealTime, StepAndOutputAllocateNothing) {
   EXPECT_EQ(counter.releases, 3);
 }
 
+TEST(RealTime, SteppingManyAllocatesNothing) {
+  quiver::test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  std::vector<qv_instance*> instances(11);
+  for (auto& s : instances) ASSERT_EQ(qv_instance_create(m.model, &config, nullptr, &s), QV_OK);
+  const size_t bytes = qv_instances_step_scratch_size(m.model, 1);
+  void* scratch = std::aligned_alloc(64, (bytes + 63) / 64 * 64);
+  std::vector<qv_step_status> statuses(instances.size());
+  const double g[3] = {0, 0, -9.81};
+  const long before = heapCalls.load();
+  for (int step = 0; step < 50; ++step) {
+    for (qv_instance* s : instances) qv_instance_set_gravity(s, g);
+    EXPECT_EQ(qv_instances_step(instances.data(), static_cast<int>(instances.size()), nullptr, scratch, bytes,
+                                statuses.data()),
+              QV_OK);
+  }
+  EXPECT_EQ(heapCalls.load() - before, 0);
+  std::free(scratch);
+  for (qv_instance* s : instances) qv_instance_destroy(s);
+}
+
 TEST(RealTime, InstanceInCallerMemoryAndModelThroughCallerAllocator) {
   quiver::test::TestModel m;
   ASSERT_NE(m.model, nullptr);

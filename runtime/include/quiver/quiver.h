@@ -227,6 +227,31 @@ typedef struct qv_step_report {
 } qv_step_report;
 QV_API void qv_instance_last_step(const qv_instance* instance, qv_step_report* report);
 
+/* Many instances of one model in one call: each is stepped as qv_instance_step() would step it,
+   but implicit Newmark St.Venant-Kirchhoff instances go in groups of 8 whose polynomial is
+   evaluated together at their steps' first guess: each coefficient is read once for the group and
+   multiplies the 8 states at once (SIMD across instances). That is the whole evaluation of a
+   QV_SOLVER_NEWTON step with one iteration, and the first of a QV_SOLVER_MINIMIZE step's (its
+   later ones depend on each instance's own line search and run one by one). The sums run in another
+   order than one instance's, so states agree with qv_instance_step() to rounding, not bit for bit
+   (docs/architecture.md, "Many instances"). Instances in a qv_world are stepped by the world.
+
+   No allocation: `scratch` (64-byte aligned) holds qv_instances_step_scratch_size(model, jobs)
+   bytes. No threads: with `jobs` not NULL the instances are cut into jobs->count contiguous ranges,
+   and jobs->run(jobs->user, job, job_data, jobs->count) must call job(job_data, i) once for each i,
+   on any threads, and return when all have run. NULL: one job on the calling thread. The same
+   instance may not appear twice. statuses[i] (when not NULL) receives instances[i]'s status.
+   QV_ERROR_INVALID_ARGUMENT: a null pointer, instances of different models, too small a scratch. */
+typedef void (*qv_job_function)(void* job_data, int job_index);
+typedef struct qv_job_runner {
+  int count; /* >= 1: how many jobs (e.g. worker threads) */
+  void (*run)(void* user, qv_job_function job, void* job_data, int job_count);
+  void* user;
+} qv_job_runner;
+QV_API size_t qv_instances_step_scratch_size(const qv_model* model, int jobs);
+QV_API qv_result qv_instances_step(qv_instance* const* instances, int count, const qv_job_runner* jobs,
+                                   void* scratch, size_t scratch_size, qv_step_status* statuses);
+
 /* Loads. Per-step (cleared by each step): a force on one vertex (N), a reduced force (r values).
    Persistent: gravity (m/s^2), and penalty constraints pulling vertices toward targets with a
    spring of `stiffness` (N/m) per vertex: one vertex dragged by the mouse, or a group held at

@@ -21,7 +21,7 @@ qv_step_status minimizing(qv_instance& s) {
   for (int i = 0; i < r; ++i) {
     s.work.predictor[i] = q[i] + h * v[i] + 0.25 * h * h * a[i];
     s.work.predictorVelocity[i] = v[i] + 0.5 * h * a[i];
-    s.end.q[i] = q[i] + h * v[i] + 0.5 * h * h * a[i];  // the guess: the last acceleration kept
+    s.end.q[i] = newmarkGuess(s, i);
   }
   const double w = 4 / (h * h);
   const qv_step_status status = minimizeStep(s, StepPredictor{w, 2 / h, h});
@@ -43,7 +43,7 @@ qv_step_status stepImplicitNewmark(qv_instance& s) {
   qv_step_status status = QV_STEP_OK;
   for (int it = 0; it < s.config.newton_iterations; ++it, ++s.lastStep.newton_iterations) {
     for (int i = 0; i < r; ++i) {
-      s.end.q[i] = q[i] + h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * s.end.a[i]);
+      s.end.q[i] = it == 0 ? newmarkGuess(s, i) : q[i] + h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * s.end.a[i]);
       s.end.v[i] = v[i] + h * ((1 - gamma) * a[i] + gamma * s.end.a[i]);
     }
     const double* J = evaluateForces(s, s.end.q);

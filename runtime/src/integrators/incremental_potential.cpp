@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "../dense_solve.h"
+#include "../dynamics.h"
 #include "../elasticity.h"
 
 namespace quiver::rt {
@@ -34,7 +35,7 @@ public:
   Point evaluate(const double* x, double* elastic) {
     Point pt;
     double E = 0, S = 0;
-    evaluateElasticity(m_, s_.config.elasticity, x, &E, s_.work.force, s_.work.stiffness, s_.work.polynomialScratch);
+    elasticityAt(s_, x, &E, s_.work.force);
     pt.jacobian = s_.loads.addStateForces(x, s_.work.force, &S);
     double inertia = 0, external = 0, damping = 0, inertiaNorm = 0, forceNorm = 0, externalNorm = 0, dampingNorm = 0;
     for (int i = 0; i < r_; ++i) velocity_[i] = v0_[i] + p_.s * (x[i] - qt_[i]);
@@ -65,7 +66,7 @@ public:
     double mu = 0;
     for (int attempt = 0; attempt < 40; ++attempt) {
       for (int i = 0; i < r_; ++i) {
-        for (int j = 0; j < r_; ++j)
+        for (int j = i; j < r_; ++j)  // the upper triangle: all Cholesky reads
           s_.work.system[i * r_ + j] = s_.work.stiffness[i * r_ + j] + jacobian[i * r_ + j] +
                                        p_.s * s_.config.rayleigh_beta * m_.restStiffness[i * r_ + j];
         s_.work.system[i * r_ + i] += diagonal + mu;

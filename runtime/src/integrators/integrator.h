@@ -24,6 +24,12 @@ struct SolverEntry {
 extern const SolverEntry kSolvers[QV_SOLVER_COUNT];
 
 qv_step_status stepImplicitNewmark(qv_instance& s);
+// Implicit Newmark's first guess at the end of the step, q + h v + h^2/2 a (the last acceleration
+// kept): where both solvers start, and where a group's preset is evaluated (step_many.h).
+inline double newmarkGuess(const qv_instance& s, int i) {
+  const double h = s.config.time_step;
+  return s.q[i] + h * s.v[i] + 0.5 * h * h * s.a[i];
+}
 qv_step_status stepBackwardEuler(qv_instance& s);
 qv_step_status stepCentralDifferences(qv_instance& s);
 

@@ -1,0 +1,209 @@
+// Many instances in one call (qv_instances_step): the group evaluation against the full-space
+// projection, states against stepping one by one, jobs, and bad arguments.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <memory>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include "runtime/src/model.h"
+#include "runtime_fixture.h"
+
+namespace {
+
+struct AlignedFree {
+  void operator()(void* p) const { std::free(p); }
+};
+using Scratch = std::unique_ptr<void, AlignedFree>;
+
+Scratch scratchFor(const qv_model* model, int jobs, size_t& bytes) {
+  bytes = qv_instances_step_scratch_size(model, jobs);
+  return Scratch(std::aligned_alloc(64, (bytes + 63) / 64 * 64));
+}
+
+// `count` instances of the suite's bar, each under its own load: gravity, a push on the tip that
+// differs per instance and flips every 20 steps, a reduced force on mode (i mod r).
+struct Crowd {
+  std::vector<std::unique_ptr<quiver::test::Instance>> owned;
+  std::vector<qv_instance*> instances;
+  int tip = 0, r = 0;
+
+  Crowd(const quiver::test::TestModel& m, const qv_instance_config& config, int count) : tip(m.tipVertex()), r(m.info.r) {
+    const double g[3] = {0, 0, -9.81};
+    for (int i = 0; i < count; ++i) {
+      owned.push_back(std::make_unique<quiver::test::Instance>(m.model, config));
+      instances.push_back(owned.back()->s);
+      qv_instance_set_gravity(instances.back(), g);
+    }
+  }
+  void load(int step) {
+    for (size_t i = 0; i < instances.size(); ++i) {
+      const double sign = (step / 20) % 2 ? -1.0 : 1.0;
+      const double push[3] = {0, sign * (2.0 + 0.5 * i), 1.0 * (i % 3)};
+      qv_instance_add_vertex_force(instances[i], tip, push);
+      std::vector<double> reduced(r, 0.0);
+      reduced[i % r] = 0.2 * sign;
+      qv_instance_add_reduced_force(instances[i], reduced.data());
+    }
+  }
+  std::vector<double> state(size_t i) const {
+    std::vector<double> q(r), v(r), a(r);
+    qv_instance_get_state(instances[i], q.data(), v.data(), a.data());
+    q.insert(q.end(), v.begin(), v.end());
+    return q;
+  }
+};
+
+// Up to 2 jobs, each on its own thread.
+void runOnThreads(void*, qv_job_function job, void* data, int count) {
+  std::vector<std::thread> threads;
+  for (int i = 0; i < count; ++i) threads.emplace_back(job, data, i);
+  for (auto& t : threads) t.join();
+}
+
+} // namespace
+
+TEST(StepMany, GroupEvaluationMatchesTheFullSpaceProjection) {
+  quiver::test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  const int r = m.info.r, count = 5;  // a partial group: the unused lanes must not leak in
+  const quiver::rt::ReducedPolynomial& poly = m.model->polynomial;
+  std::vector<double> scratch(quiver::rt::ReducedPolynomial::laneScratchSize(r) + 8);
+  double* aligned = scratch.data() + (8 - reinterpret_cast<uintptr_t>(scratch.data()) / 8 % 8) % 8;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n(0, 1);
+  std::vector<Eigen::VectorXd> q(count), force(count, Eigen::VectorXd(r));
+  std::vector<Eigen::MatrixXd> K(count, Eigen::MatrixXd(r, r));
+  std::vector<const double*> at(count);
+  std::vector<double*> forces(count), stiffnesses(count);
+  double energy[quiver::rt::ReducedPolynomial::kLanes];
+  for (int i = 0; i < count; ++i) {
+    q[i] = Eigen::VectorXd(r);
+    for (auto& x : q[i]) x = n(rng);
+    q[i] *= (0.05 + 0.05 * i) / (m.U * q[i]).cwiseAbs().maxCoeff();  // up to 0.25 m on a 1 m bar
+    at[i] = q[i].data();
+    forces[i] = force[i].data();
+    stiffnesses[i] = K[i].data();
+  }
+  poly.evaluateLanes(at.data(), count, energy, forces.data(), stiffnesses.data(), aligned);
+  for (int i = 0; i < count; ++i) {
+    Eigen::VectorXd exactForce;
+    Eigen::MatrixXd exactK;
+    m.exact(q[i], exactForce, exactK);
+    EXPECT_LT((force[i] - exactForce).norm(), 1e-9 * exactForce.norm()) << "state " << i;
+    EXPECT_LT((K[i] - exactK).norm(), 1e-9 * exactK.norm()) << "state " << i;
+    const double exactEnergy = m.elasticEnergy(q[i]);
+    EXPECT_NEAR(energy[i], exactEnergy, 1e-9 * exactEnergy) << "state " << i;
+  }
+}
+
+TEST(StepMany, StatesAgreeWithSteppingOneByOne) {
+  quiver::test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  for (qv_solver solver : {QV_SOLVER_NEWTON, QV_SOLVER_MINIMIZE}) {
+    qv_instance_config config;
+    qv_instance_config_init(&config, m.model);
+    config.solver = solver;
+    config.newton_iterations = solver == QV_SOLVER_NEWTON ? 1 : config.newton_iterations;
+    const int count = 21;  // two full groups and one of 5
+    Crowd batched(m, config, count), single(m, config, count);
+    size_t bytes = 0;
+    Scratch scratch = scratchFor(m.model, 1, bytes);
+    std::vector<qv_step_status> statuses(count, QV_STEP_RESET);
+    double largest = 0, worst = 0;
+    for (int step = 0; step < 120; ++step) {
+      batched.load(step);
+      single.load(step);
+      ASSERT_EQ(qv_instances_step(batched.instances.data(), count, nullptr, scratch.get(), bytes, statuses.data()), QV_OK);
+      for (int i = 0; i < count; ++i) {
+        const qv_step_status alone = qv_instance_step(single.instances[i]);
+        EXPECT_EQ(statuses[i], alone) << "instance " << i << " step " << step;
+      }
+    }
+    for (int i = 0; i < count; ++i) {
+      const std::vector<double> a = batched.state(i), b = single.state(i);
+      for (int k = 0; k < m.info.r; ++k) {  // q: the displacements' scale
+        largest = std::max(largest, std::abs(b[k]));
+        worst = std::max(worst, std::abs(a[k] - b[k]));
+      }
+    }
+    // The bound of docs/architecture.md ("Many instances"): 1e-9 of the largest coordinate after
+    // 120 steps (2 s) of changing loads. Zero would mean the groups never evaluated anything.
+    EXPECT_LT(worst, 1e-9 * largest) << qv_solver_name(solver);
+    EXPECT_GT(worst, 0.0) << qv_solver_name(solver) << ": every state bit-identical, so no group evaluation was used";
+    EXPECT_GT(largest, 1e-3);
+  }
+}
+
+TEST(StepMany, JobsOnThreadsGiveTheSameStatesAsOneJob) {
+  quiver::test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  const int count = 20;  // one job: groups of 8, 8, 4; two: 8, 2 and 8, 2
+  Crowd one(m, config, count), two(m, config, count);
+  size_t bytes1 = 0, bytes2 = 0;
+  Scratch s1 = scratchFor(m.model, 1, bytes1), s2 = scratchFor(m.model, 2, bytes2);
+  qv_job_runner jobs{2, runOnThreads, nullptr};
+  for (int step = 0; step < 40; ++step) {
+    one.load(step);
+    two.load(step);
+    ASSERT_EQ(qv_instances_step(one.instances.data(), count, nullptr, s1.get(), bytes1, nullptr), QV_OK);
+    ASSERT_EQ(qv_instances_step(two.instances.data(), count, &jobs, s2.get(), bytes2, nullptr), QV_OK);
+  }
+  // Each lane's sums are the same whichever group it sits in, so how the jobs cut the groups
+  // changes no bit (neither cut leaves a group of one, which takes the one-state path).
+  for (int i = 0; i < count; ++i) EXPECT_EQ(one.state(i), two.state(i)) << "instance " << i;
+}
+
+TEST(StepMany, OtherIntegratorsAndLoneInstancesStepAsAlone) {
+  quiver::test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  config.integrator = QV_INTEGRATOR_BACKWARD_EULER;
+  Crowd batched(m, config, 3), single(m, config, 3);
+  qv_instance_config newmark;
+  qv_instance_config_init(&newmark, m.model);
+  Crowd lone(m, newmark, 1), loneSingle(m, newmark, 1);
+  batched.instances.push_back(lone.instances[0]);  // one Newmark instance among Euler ones: a group of one
+  single.instances.push_back(loneSingle.instances[0]);
+  size_t bytes = 0;
+  Scratch scratch = scratchFor(m.model, 1, bytes);
+  for (int step = 0; step < 30; ++step) {
+    batched.load(step);
+    single.load(step);
+    ASSERT_EQ(qv_instances_step(batched.instances.data(), 4, nullptr, scratch.get(), bytes, nullptr), QV_OK);
+    for (qv_instance* s : single.instances) qv_instance_step(s);
+  }
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(batched.state(i), single.state(i)) << "instance " << i;
+}
+
+TEST(StepMany, BadArgumentsAreRefused) {
+  quiver::test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  qv_model* other = nullptr;
+  ASSERT_EQ(qv_model_load_file(QUIVER_RUNTIME_MODEL, nullptr, nullptr, &other, nullptr, 0), QV_OK);
+  quiver::test::Instance a(m.model, config), b(other, config);
+  size_t bytes = 0;
+  Scratch scratch = scratchFor(m.model, 2, bytes);
+  qv_instance* mixed[2] = {a.s, b.s};
+  EXPECT_EQ(qv_instances_step(mixed, 2, nullptr, scratch.get(), bytes, nullptr), QV_ERROR_INVALID_ARGUMENT);
+  qv_instance* same[2] = {a.s, a.s};
+  EXPECT_EQ(qv_instances_step(same, 1, nullptr, scratch.get(), bytes / 2 - 1, nullptr), QV_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(qv_instances_step(same, 1, nullptr, static_cast<char*>(scratch.get()) + 8, bytes - 8, nullptr),
+            QV_ERROR_INVALID_ARGUMENT);
+  qv_job_runner noRun{2, nullptr, nullptr};
+  EXPECT_EQ(qv_instances_step(same, 1, &noRun, scratch.get(), bytes, nullptr), QV_ERROR_INVALID_ARGUMENT);
+  qv_job_runner three{3, runOnThreads, nullptr};  // scratch for 2 jobs only
+  EXPECT_EQ(qv_instances_step(same, 1, &three, scratch.get(), bytes, nullptr), QV_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(qv_instances_step(nullptr, 1, nullptr, scratch.get(), bytes, nullptr), QV_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(qv_instances_step(same, 0, nullptr, nullptr, 0, nullptr), QV_OK);
+  EXPECT_EQ(qv_instances_step_scratch_size(nullptr, 1), 0u);
+  EXPECT_EQ(qv_instances_step_scratch_size(m.model, 0), 0u);
+  qv_model_destroy(other);
+}
