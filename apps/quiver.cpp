@@ -161,6 +161,8 @@ int main(int argc, char** argv) {
   quiver::app::addIntegratorOption(*sim, simOptions.step.integrator);
   quiver::app::addElasticityOption(*sim, simOptions.step.elasticity);
   quiver::app::addSolverOption(*sim, simOptions.step.solver);
+  quiver::app::CrowdOptions crowd;
+  crowd.addTo(*sim);
   CLI::App* render = app.add_subcommand("render", "Draw MODEL.qvr without a display: rest, after (or during) a scenario, or its modes; PNG, GIF or image sequence");
   quiver::app::RenderOptions renderOptions;
   render->add_option("model", path, "Model file (.qvr)")->required();
@@ -193,6 +195,7 @@ int main(int argc, char** argv) {
                                             fullSim);
     }
     if (*render) return quiver::app::renderModel(path, renderOptions);
+    if (*sim && crowd.instances > 0) return quiver::app::simulateCrowd(path, simOptions, crowd);
     if (*sim) return quiver::app::simulateModel(path, simOptions);
     const quiver::app::RuntimeModel model(path);
     const ordered_json out = *info ? describeModel(model) : evaluateModel(model, qText);

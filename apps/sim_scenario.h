@@ -85,6 +85,16 @@ double percentile(std::vector<double> values, double p);
 // `quiver sim MODEL.qvr`: returns the exit code.
 int simulateModel(const std::string& modelPath, const SimOptions& options);
 
+// `quiver sim MODEL.qvr --instances N`: a crowd of one model stepped together per frame.
+struct CrowdOptions {
+  int instances = 0;      // 0: one instance, the scenario as above
+  int threads = 1;        // the caller's thread included
+  bool oneByOne = false;  // qv_instance_step on each, for comparison
+
+  void addTo(CLI::App& app);
+};
+int simulateCrowd(const std::string& modelPath, const SimOptions& options, const CrowdOptions& crowd);
+
 struct FullSpaceOptions {
   std::string solver = "ldlt";          // llt | ldlt | cg | lu
   MaterialOverride material;            // over the mesh file's materials

@@ -173,6 +173,22 @@ class QuiverSim(OnTheBakedModel):
                                 "--json").stdout)
         self.assertEqual(j["resets"], 0)
 
+    def test_instances_report_frame_times(self):
+        for extra, threads, stepping in (([], 1, "together"), (["--threads", 2], 2, "together"),
+                                         (["--one-by-one"], 1, "one by one")):
+            j = json.loads(self.sim("--instances", 20, "--steps", 30, "--hold", 10, "--json", *extra).stdout)
+            self.assertEqual((j["instances"], j["threads"], j["stepping"], j["steps"], j["resets"]),
+                             (20, threads, stepping, 30, 0))
+            self.assertGreater(j["frame_ms_median"], 0)
+            self.assertLessEqual(j["frame_ms_median"], j["frame_ms_p99"])
+            self.assertAlmostEqual(j["instance_step_us_median"], 1e3 * j["frame_ms_median"] / 20)
+        for args, message in ((["--instances", 0], "--instances"), (["--instances", 3, "--twist", 10], "--drag or --twist"),
+                              (["--instances", 3, "-o", os.path.join(self.tmp.name, "crowd")], "leave out -o"),
+                              (["--instances", 3, "--threads", 0], "--threads")):
+            p = self.sim(*args, ok=False)
+            self.assertNotEqual(p.returncode, 0)
+            self.assertIn(message, p.stderr)
+
     def test_bad_options(self):
         for args, message in ((["--group", "x<-5"], "selects no vertex"), (["--group", "q<1"], "--group"),
                               (["--dt", "-1"], "--dt"), (["--newton", "0"], "--newton"), (["--solver", "gauss"], "gauss")):
