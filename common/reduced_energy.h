@@ -23,19 +23,23 @@
 namespace quiver {
 
 // Writes the six rows of B_e, tet after tet; its scratch is sized once so the loop allocates nothing.
+// It keeps the basis vertex-major (each vertex's 3 x r block contiguous: a tet reads four runs of
+// memory) and builds each tet's G_j entry by entry as arrays over j, so that the products
+// G_j^T G_k run as vector loops over k.
 class ReducedEnergyRows {
 public:
-  explicit ReducedEnergyRows(int r);
-  int columns() const { return static_cast<int>(LS_.cols()); }  // r + r(r+1)/2
+  // `basis`: 3n x r, vertex order.
+  explicit ReducedEnergyRows(const Eigen::MatrixXd& basis);
+  int columns() const { return r_ + r_ * (r_ + 1) / 2; }
 
-  // `basis`: 3n x r, vertex order. B: column-major, leading dimension `ld` (>= 6).
-  void write(const Eigen::MatrixXd& basis, const Tet& tet, const Matrix34& gradients, double volume,
-             const Material& material, double* B, int64_t ld);
+  // B: column-major, leading dimension `ld` (>= 6).
+  void write(const Tet& tet, const Matrix34& gradients, double volume, const Material& material, double* B, int64_t ld);
 
 private:
   int r_;
-  std::vector<Eigen::Matrix3d> G_;
-  Eigen::Matrix<double, 6, Eigen::Dynamic> LS_;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> vertexMajor_;  // the basis, 3n x r row-major
+  std::vector<double> g_;      // G_j(c, d) at [(3 c + d) r + j]
+  std::vector<double> strain_; // one row j of the products: the 6 Voigt components over k, [component r + k]
 };
 
 // sum_e B_e^T B_e over every tet (upper triangle filled).

@@ -17,7 +17,7 @@ EnergyPolynomial computeEnergyPolynomial(MPI_Comm comm, const TetMesh& mesh, con
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   const int r = static_cast<int>(basis.cols());
-  ReducedEnergyRows rows(r);
+  ReducedEnergyRows rows(basis);
   const int N = rows.columns();
   std::vector<int> mine;
   for (int t = 0; t < mesh.tetCount(); ++t)
@@ -32,7 +32,7 @@ EnergyPolynomial computeEnergyPolynomial(MPI_Comm comm, const TetMesh& mesh, con
     const int count = static_cast<int>(std::min<size_t>(block, mine.size() - first));
     for (int b = 0; b < count; ++b) {
       const int t = mine[first + b];
-      rows.write(basis, mesh.tets[t], elements.gradients[t], elements.volume[t], perTet[t], B.data() + 6 * b, ld);
+      rows.write(mesh.tets[t], elements.gradients[t], elements.volume[t], perTet[t], B.data() + 6 * b, ld);
     }
     cblas_dsyrk(CblasColMajor, CblasUpper, CblasTrans, N, 6 * count, 1.0, B.data(), static_cast<int>(ld), 1.0,
                 gram.data(), N);
