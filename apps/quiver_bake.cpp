@@ -5,10 +5,12 @@
 
 #include "apps/support/mesh_options.h"
 #include "precompute/bake.h"
+#include "precompute/blas_core.h"
 
 using namespace quiver;
 
 int main(int argc, char** argv) {
+  const std::string blas = chooseBlasCore(argv);  // may run the program again: before anything else
   std::vector<std::string> own, petsc;
   splitPetscOptions(argc, argv, own, petsc);
 
@@ -89,6 +91,7 @@ int main(int argc, char** argv) {
 
   BakeContext ctx(petsc);
   ctx.quiet = quiet;
+  ctx.progress(blas);
   std::string error;
   try {
     checkBakeSettings(s);  // before any work

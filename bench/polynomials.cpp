@@ -41,6 +41,7 @@
 #include "common/tet_mesh.h"
 #include "formats/mesh/read_mesh.h"
 #include "precompute/bake_context.h"
+#include "precompute/blas_core.h"
 #include "precompute/stages/partition.h"
 #include "precompute/stages/polynomials.h"
 
@@ -235,6 +236,7 @@ int run(const quiver::BakeContext& ctx, const Options& o) {
 } // namespace
 
 int main(int argc, char** argv) {
+  quiver::chooseBlasCore(argv);  // the kernels the bake would run on (the "# OpenBLAS" line names them)
   Options options;
   try {
     options = parseOptions(argc, argv);

@@ -2,6 +2,7 @@
 """quiver-bake from the outside, on 1 and 2 MPI ranks: it runs, 1 and 2 ranks agree, a killed bake
 resumes to the same result, and bad input is refused with one clear message, never a hang."""
 import os
+import re
 import signal
 import subprocess
 import tempfile
@@ -86,6 +87,34 @@ class QuiverBake(unittest.TestCase):
         for key in ("modes", "U"):
             scale = np.abs(a[key]).max()
             np.testing.assert_allclose(b[key], a[key], atol=1e-8 * scale, err_msg=key)
+
+    def test_blas_kernels_follow_the_cpu(self):
+        # OpenBLAS on a CPU it does not know picks its SSE3 kernels; OPENBLAS_CORETYPE=Prescott stands
+        # for that here. With QUIVER_BLAS_CORE=auto the bake chooses by the CPU's features and runs
+        # itself again (every rank), with the same arguments: the same model comes out.
+        name = os.path.join(self.dir, "kernels")
+        env = dict(os.environ, OPENBLAS_CORETYPE="Prescott", QUIVER_BLAS_CORE="auto")
+        p = subprocess.run(command(2, self.beam, "--fix", "x<min+1e-9", "--E", "1e6", "--nu", "0.45", "--density", "1000",
+                                   "--modes", "6", "--rank", "12", "--export-npy", "--no-fidelity", "-o", name),
+                           capture_output=True, text=True, timeout=300, stdin=subprocess.DEVNULL, env=env)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        line = next(l for l in p.stdout.splitlines() if "BLAS: OpenBLAS core" in l)
+        cpu = re.search(r"this CPU: ([\w-]+)", line).group(1)
+        if cpu == "SSE":
+            self.assertIn("core Prescott", line)  # nothing better to run
+        else:
+            self.assertIn("OpenBLAS alone had picked Prescott", line)
+            self.assertNotIn("core Prescott", line)
+        a, b = load(self.results[2][1]), load(name)
+        np.testing.assert_allclose(b["eigenvalues"], a["eigenvalues"], rtol=1e-8)
+        # The user's own OPENBLAS_CORETYPE is kept, with a warning in the log.
+        env.pop("QUIVER_BLAS_CORE")
+        p = subprocess.run(command(1, self.beam, "--fix", "x<min+1e-9", "--modes", "2", "--rank", "3", "--no-fidelity",
+                                   "-o", name), capture_output=True, text=True, timeout=300, stdin=subprocess.DEVNULL, env=env)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("core Prescott", p.stdout)
+        if cpu != "SSE":
+            self.assertIn("slower kernels than this CPU can run", p.stdout)
 
     def test_petsc_options_pass_through(self):
         p = bake(1, self.beam, "--fix", "x<min+1e-9", "--modes", "2", "--rank", "3", "-o",
