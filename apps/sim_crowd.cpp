@@ -25,13 +25,15 @@ struct AlignedFree {
 void CrowdOptions::addTo(CLI::App& app) {
   app.add_option("--instances", instances,
                  "Step N instances of the model together per frame (qv_instances_step), each under its own share of "
-                 "the load: --force scaled by 0.5 to 1.5 across them, or without --force a pull on the group of 2% "
-                 "of the model's weight turning about x from one to the next; reports frame times")
+                 "the load: --force scaled by 0.5 to 1.5 across them, or with neither --force nor --gravity a pull on "
+                 "the group of 2% of the model's weight turning about x from one to the next; reports frame times")
       ->check(CLI::Range(1, 1000000));
+  CLI::Option* given = app.get_option("--instances");
   app.add_option("--threads", threads, "With --instances: jobs on this many threads (the caller's included)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 256));
-  app.add_flag("--one-by-one", oneByOne, "With --instances: qv_instance_step on each instead, to compare");
+      ->check(CLI::Range(1, 256))
+      ->needs(given);
+  app.add_flag("--one-by-one", oneByOne, "With --instances: qv_instance_step on each instead, to compare")->needs(given);
 }
 
 int simulateCrowd(const std::string& path, const SimOptions& o, const CrowdOptions& c) {
@@ -66,7 +68,7 @@ int simulateCrowd(const std::string& path, const SimOptions& o, const CrowdOptio
     }
     for (int a = 0; a < 3; ++a) share[3 * k + a] = scale * total[a] / group.size();
   }
-  JobPool pool(c.threads);
+  JobPool pool(c.oneByOne ? 1 : c.threads);
   const qv_job_runner runner = pool.runner();
   const size_t bytes = qv_instances_step_scratch_size(model.get(), pool.threads());
   std::unique_ptr<void, AlignedFree> scratch(std::aligned_alloc(64, (bytes + 63) / 64 * 64));

@@ -1,10 +1,12 @@
 // The runtime's hot paths on baked models, single thread (Google Benchmark):
-//   Evaluate/force, Evaluate/force+stiffness, Step/newton (implicit Newmark, Barbic & James's one
-//   Newton iteration), Step/minimize (the default solver), both under a load that keeps the object
-//   moving, and ManyObjects: 1000 instances of one model stepped per frame (both solvers, one by one
-//   and in one qv_instances_step call).
-// Peak FMA throughput of this core is measured in the same run (PeakFma) so that the evaluation
-// can be reported as a fraction of it. Each benchmark's label carries a hash of its final state.
+//   Evaluate/force, Evaluate/force+stiffness (float64 and float32 coefficients), Step/newton
+//   (implicit Newmark, Barbic & James's one Newton iteration; both precisions), Step/minimize (the
+//   default solver), both under a load that keeps the object moving, and ManyObjects: 1000
+//   instances of one model stepped per frame (both solvers, one by one and in one
+//   qv_instances_step call).
+// Measured in the same run, as yardsticks: this core's peak FMA throughput (PeakFma) and a plain
+// read of as many bytes as one evaluation streams (Stream/f64, Stream/f32: the floor set by
+// wherever those bytes sit). Each benchmark's label carries a hash of its final state.
 //   bench/runtime.py --build build/release     (bakes the models, runs this, prints the table)
 //   build/release/bench/bench_runtime MODEL.qvr [MODEL.qvr ...] [--benchmark_* flags]
 #include <benchmark/benchmark.h>
@@ -19,6 +21,7 @@
 #include "formats/model/fnv1a.h"
 #include "formats/model/qvr.h"
 #include "quiver/quiver.h"
+#include "runtime/src/reduced_polynomial.h"
 
 namespace {
 
@@ -42,9 +45,12 @@ double evaluationFlops(int r) {
 struct Loaded {
   qv_model* model = nullptr;
   qv_model_info info{};
-  explicit Loaded(const char* path) {
+  explicit Loaded(const char* path, int precision = 64) {
     char message[512];
-    if (qv_model_load_file(path, nullptr, nullptr, &model, message, sizeof message) != QV_OK) {
+    qv_model_config config;
+    qv_model_config_init(&config);
+    config.coefficient_precision = precision;
+    if (qv_model_load_file(path, &config, nullptr, &model, message, sizeof message) != QV_OK) {
       std::fprintf(stderr, "%s\n", message);
       std::exit(1);
     }
@@ -52,34 +58,58 @@ struct Loaded {
   }
 };
 
-// 12 independent fused multiply-add chains of 8 doubles: what one core can sustain.
+// 12 independent fused multiply-add chains of W doubles: what one core can sustain, with the
+// widest vectors it has (AVX-512: W = 8, AVX2: W = 4).
 typedef double v8 __attribute__((vector_size(64)));
-__attribute__((target("avx512f,fma"), noinline)) double fmaChains(long iterations) {
-  v8 acc[12];
-  const v8 a = {1.0000001, 1.0000001, 1.0000001, 1.0000001, 1.0000001, 1.0000001, 1.0000001, 1.0000001};
-  const v8 b = {1e-9, 1e-9, 1e-9, 1e-9, 1e-9, 1e-9, 1e-9, 1e-9};
+typedef double v4 __attribute__((vector_size(32)));
+template <class vec, int W>
+__attribute__((always_inline)) inline double fmaChains(long iterations) {  // compiled in its callers' targets
+  vec acc[12], a, b;
+  for (int k = 0; k < W; ++k) a[k] = 1.0000001, b[k] = 1e-9;
   for (int i = 0; i < 12; ++i) acc[i] = b * (1.0 + i);  // distinct chains: none can be merged
   for (long i = 0; i < iterations; ++i)
     for (auto& x : acc) x = x * a + b;
   double sum = 0;
   for (auto& x : acc)
-    for (int k = 0; k < 8; ++k) sum += x[k];
+    for (int k = 0; k < W; ++k) sum += x[k];
   return sum;
 }
+__attribute__((target("avx512f,fma"), noinline)) double fmaChains512(long n) { return fmaChains<v8, 8>(n); }
+__attribute__((target("avx2,fma"), noinline)) double fmaChains256(long n) { return fmaChains<v4, 4>(n); }
 
-void PeakFma(benchmark::State& state) {
+void PeakFma(benchmark::State& state, int width) {
   const long iterations = 1 << 20;
   for (auto _ : state) {
     long n = iterations;
     benchmark::DoNotOptimize(n);  // an opaque argument: the (pure) call cannot be hoisted out of the loop
-    benchmark::DoNotOptimize(fmaChains(n));
+    benchmark::DoNotOptimize(width == 8 ? fmaChains512(n) : fmaChains256(n));
   }
-  state.counters["GFLOPS"] = benchmark::Counter(2.0 * 8 * 12 * iterations * state.iterations(),
+  state.counters["GFLOPS"] = benchmark::Counter(2.0 * width * 12 * iterations * state.iterations(),
                                                 benchmark::Counter::kIsRate, benchmark::Counter::kIs1000);
 }
 
-void Evaluate(benchmark::State& state, const char* path, bool withStiffness) {
-  Loaded m(path);
+// Reads `bytes` (the coefficients one evaluation streams) as doubles, 8 independent sums: the
+// floor an evaluation of that many bytes meets where they sit (L1, L2, L3 or memory), in the same
+// run. The buffer is read again and again, as the evaluation reads its coefficients.
+__attribute__((noinline)) double streamSum(const double* x, size_t n) {
+  double s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  size_t i = 0;
+  for (; i + 8 <= n; i += 8)
+    for (int k = 0; k < 8; ++k) s[k] += x[i + k];
+  for (; i < n; ++i) s[0] += x[i];
+  return s[0] + s[1] + s[2] + s[3] + s[4] + s[5] + s[6] + s[7];
+}
+
+void Stream(benchmark::State& state, size_t bytes) {
+  std::vector<double> buffer(bytes / sizeof(double), 1.0);
+  for (auto _ : state) benchmark::DoNotOptimize(streamSum(buffer.data(), buffer.size()));
+  state.counters["bytes"] = static_cast<double>(bytes);
+  state.counters["GBps"] = benchmark::Counter(static_cast<double>(bytes) * state.iterations(), benchmark::Counter::kIsRate,
+                                              benchmark::Counter::kIs1000);
+}
+
+void Evaluate(benchmark::State& state, const char* path, bool withStiffness, int precision) {
+  Loaded m(path, precision);
   const int r = m.info.r;
   std::vector<double> q(r), force(r), K(static_cast<size_t>(r) * r), scratch(qv_model_scratch_size(m.model) / 8 + 1);
   for (int i = 0; i < r; ++i) q[i] = 1e-3 * (i + 1);
@@ -96,8 +126,8 @@ void Evaluate(benchmark::State& state, const char* path, bool withStiffness) {
 
 // Gravity, plus twice its pull on the first coordinate flipping every half second, so that every
 // step has work to do (a settled object converges at once and would flatter the solver).
-void Step(benchmark::State& state, const char* path, qv_solver solver) {
-  Loaded m(path);
+void Step(benchmark::State& state, const char* path, qv_solver solver, int precision) {
+  Loaded m(path, precision);
   qv_instance_config config;
   qv_instance_config_init(&config, m.model);
   config.solver = solver;
@@ -158,7 +188,6 @@ void ManyObjects(benchmark::State& state, const char* path, qv_solver solver, bo
     ++frame;
   }
   state.counters["r"] = r;
-  state.counters["frame_ms"] = benchmark::Counter(1e3 * state.iterations(), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.counters["resets"] = static_cast<double>(resets);  // expected 0: a reset step is no measure
   state.SetLabel("state " + stateHash(all.back(), r));
   std::free(scratch);
@@ -170,16 +199,25 @@ void ManyObjects(benchmark::State& state, const char* path, qv_solver solver, bo
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
-  if (__builtin_cpu_supports("avx512f")) benchmark::RegisterBenchmark("PeakFma", PeakFma);
+  if (__builtin_cpu_supports("avx512f"))
+    benchmark::RegisterBenchmark("PeakFma", PeakFma, 8);
+  else if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+    benchmark::RegisterBenchmark("PeakFma", PeakFma, 4);
   for (int i = 1; i < argc; ++i) {
     const char* path = argv[i];
     Loaded probe(path);
     const std::string r = "/r" + std::to_string(probe.info.r);
     qv_model_destroy(probe.model);
-    benchmark::RegisterBenchmark(("Evaluate/force" + r).c_str(), Evaluate, path, false)->Unit(benchmark::kMicrosecond);
-    benchmark::RegisterBenchmark(("Evaluate/force+stiffness" + r).c_str(), Evaluate, path, true)->Unit(benchmark::kMicrosecond);
-    benchmark::RegisterBenchmark(("Step/newton" + r).c_str(), Step, path, QV_SOLVER_NEWTON)->Unit(benchmark::kMicrosecond);
-    benchmark::RegisterBenchmark(("Step/minimize" + r).c_str(), Step, path, QV_SOLVER_MINIMIZE)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("Evaluate/force" + r).c_str(), Evaluate, path, false, 64)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("Evaluate/force+stiffness" + r).c_str(), Evaluate, path, true, 64)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("Evaluate/force+stiffness/f32" + r).c_str(), Evaluate, path, true, 32)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("Step/newton" + r).c_str(), Step, path, QV_SOLVER_NEWTON, 64)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("Step/newton/f32" + r).c_str(), Step, path, QV_SOLVER_NEWTON, 32)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("Step/minimize" + r).c_str(), Step, path, QV_SOLVER_MINIMIZE, 64)->Unit(benchmark::kMicrosecond);
+    for (bool single : {false, true})
+      benchmark::RegisterBenchmark(("Stream/" + std::string(single ? "f32" : "f64") + r).c_str(), Stream,
+                                   quiver::rt::ReducedPolynomial::storageBytes(probe.info.r, single))
+          ->Unit(benchmark::kMicrosecond);
     if (probe.info.r == 20 || probe.info.r == 30)
       for (qv_solver solver : {QV_SOLVER_NEWTON, QV_SOLVER_MINIMIZE})
         for (bool together : {false, true})

@@ -1,5 +1,6 @@
 #include "common/reduced_energy.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Cholesky>
@@ -7,16 +8,6 @@
 namespace quiver {
 
 namespace {
-
-// Symmetric 3x3 as the 6-vector (xx, yy, zz, yz, xz, xy), scaled by `s`.
-inline void voigt(const Eigen::Matrix3d& A, double s, double* out) {
-  out[0] = s * A(0, 0);
-  out[1] = s * A(1, 1);
-  out[2] = s * A(2, 2);
-  out[3] = s * 0.5 * (A(1, 2) + A(2, 1));
-  out[4] = s * 0.5 * (A(0, 2) + A(2, 0));
-  out[5] = s * 0.5 * (A(0, 1) + A(1, 0));
-}
 
 // C with C^T C = V (\mu W + \tfrac{\lambda}{2} t t^T): the normal block is dense, the shear block diagonal.
 Eigen::Matrix<double, 6, 6> energyFactor(double V, double lambda, double mu) {
@@ -29,9 +20,17 @@ Eigen::Matrix<double, 6, 6> energyFactor(double V, double lambda, double mu) {
 
 } // namespace
 
-ReducedEnergyRows::ReducedEnergyRows(const Eigen::MatrixXd& basis)
-    : r_(static_cast<int>(basis.cols())), vertexMajor_(basis), g_(9 * static_cast<size_t>(r_)),
-      strain_(6 * static_cast<size_t>(r_)) {}
+ReducedEnergyRows::ReducedEnergyRows(const Eigen::MatrixXd& basis, const TetMesh& mesh, const std::vector<int>& tets)
+    : r_(static_cast<int>(basis.cols())), row_(mesh.vertexCount(), -1), g_(9 * static_cast<size_t>(r_)),
+      strain_(6 * static_cast<size_t>(r_)) {
+  int used = 0;
+  for (int t : tets)
+    for (int v : mesh.tets[t])
+      if (row_[v] < 0) row_[v] = used++;
+  vertexMajor_.resize(3 * static_cast<Eigen::Index>(used), r_);
+  for (int v = 0; v < mesh.vertexCount(); ++v)
+    if (row_[v] >= 0) vertexMajor_.middleRows<3>(3 * static_cast<Eigen::Index>(row_[v])) = basis.middleRows<3>(3 * static_cast<Eigen::Index>(v));
+}
 
 void ReducedEnergyRows::write(const Tet& tet, const Matrix34& grad, double volume, const Material& material, double* B,
                               int64_t ld) {
@@ -40,7 +39,7 @@ void ReducedEnergyRows::write(const Tet& tet, const Matrix34& grad, double volum
   std::fill(g_.begin(), g_.end(), 0.0);
   for (int v = 0; v < 4; ++v)
     for (int c = 0; c < 3; ++c) {
-      const double* row = vertexMajor_.data() + (3 * static_cast<int64_t>(tet[v]) + c) * r;
+      const double* row = vertexMajor_.data() + (3 * static_cast<int64_t>(row_[tet[v]]) + c) * r;
       for (int d = 0; d < 3; ++d) {
         double* out = g_.data() + (3 * c + d) * r;
         const double w = grad(d, v);
@@ -92,7 +91,9 @@ void ReducedEnergyRows::write(const Tet& tet, const Matrix34& grad, double volum
 Eigen::MatrixXd reducedEnergyGram(const TetMesh& mesh, const std::vector<Material>& perTet,
                                   const Eigen::MatrixXd& basis) {
   const TetElements elements = computeTetElements(mesh);
-  ReducedEnergyRows rows(basis);
+  std::vector<int> all(mesh.tetCount());
+  for (int t = 0; t < mesh.tetCount(); ++t) all[t] = t;
+  ReducedEnergyRows rows(basis, mesh, all);
   Eigen::MatrixXd B(6, rows.columns()), gram = Eigen::MatrixXd::Zero(rows.columns(), rows.columns());
   for (int t = 0; t < mesh.tetCount(); ++t) {
     rows.write(mesh.tets[t], elements.gradients[t], elements.volume[t], perTet[t], B.data(), 6);

@@ -23,13 +23,13 @@
 namespace quiver {
 
 // Writes the six rows of B_e, tet after tet; its scratch is sized once so the loop allocates nothing.
-// It keeps the basis vertex-major (each vertex's 3 x r block contiguous: a tet reads four runs of
-// memory) and builds each tet's G_j entry by entry as arrays over j, so that the products
-// G_j^T G_k run as vector loops over k.
+// It keeps the basis rows of the tets it will see vertex-major (each vertex's 3 x r block
+// contiguous: a tet reads four runs of memory) and builds each tet's G_j entry by entry as arrays
+// over j, so that the products G_j^T G_k run as vector loops over k.
 class ReducedEnergyRows {
 public:
-  // `basis`: 3n x r, vertex order.
-  explicit ReducedEnergyRows(const Eigen::MatrixXd& basis);
+  // `basis`: 3n x r, vertex order; `tets`: the tets of `mesh` that write() will be given.
+  ReducedEnergyRows(const Eigen::MatrixXd& basis, const TetMesh& mesh, const std::vector<int>& tets);
   int columns() const { return r_ + r_ * (r_ + 1) / 2; }
 
   // B: column-major, leading dimension `ld` (>= 6).
@@ -37,7 +37,8 @@ public:
 
 private:
   int r_;
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> vertexMajor_;  // the basis, 3n x r row-major
+  std::vector<int> row_;  // vertex -> its block in vertexMajor_ (-1: no tet of ours uses it)
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> vertexMajor_;  // 3 rows per used vertex
   std::vector<double> g_;      // G_j(c, d) at [(3 c + d) r + j]
   std::vector<double> strain_; // one row j of the products: the 6 Voigt components over k, [component r + k]
 };

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cstdlib>
 #include <cstring>
-#include <iostream>
 
 #include <unistd.h>
 
@@ -28,8 +28,9 @@ const char* levelName(VectorLevel level) {
   }
 }
 
-// Set by the first run for the second: what OpenBLAS had picked on its own.
+// Set by the first run for the second: what OpenBLAS had picked on its own, and what was asked.
 constexpr const char* kFirstPick = "QUIVER_BLAS_FIRST_PICK";
+constexpr const char* kAsked = "QUIVER_BLAS_ASKED";
 
 } // namespace
 
@@ -79,23 +80,37 @@ std::string chooseBlasCore(char** argv) {
   const char* firstPick = std::getenv(kFirstPick);
   std::string line = "BLAS: OpenBLAS core " + current + " (this CPU: " + levelName(cpu) + ")";
   if (firstPick) {  // the second run: never a third
+    const std::string asked = std::getenv(kAsked) ? std::getenv(kAsked) : "";
     line += "; OpenBLAS alone had picked " + std::string(firstPick);
+    if (lower(asked) != lower(current))  // this OpenBLAS has no such kernels (or ignores OPENBLAS_CORETYPE)
+      line += "; " + asked + " was asked for and is not available";
     unsetenv(kFirstPick);
+    unsetenv(kAsked);
     return line;
   }
-  const std::string wanted =
-      blasCoreToRequest(cpu, current, std::getenv("QUIVER_BLAS_CORE"), std::getenv("OPENBLAS_CORETYPE"));
+  const char* quiverCore = std::getenv("QUIVER_BLAS_CORE");
+  const char* userCore = std::getenv("OPENBLAS_CORETYPE");
+  const std::string wanted = blasCoreToRequest(cpu, current, quiverCore, userCore);
   if (wanted.empty()) {
     if (coreVectorLevel(current) < cpu)
-      line += "; slower kernels than this CPU can run: OPENBLAS_CORETYPE chose them (unset it, or set QUIVER_BLAS_CORE=auto)";
+      line += std::string("; slower kernels than this CPU can run: ") +
+              (quiverCore && *quiverCore ? "QUIVER_BLAS_CORE" : "OPENBLAS_CORETYPE") + " chose them";
     return line;
   }
+  const std::string before = userCore ? userCore : "";
   setenv("OPENBLAS_CORETYPE", wanted.c_str(), 1);
   setenv(kFirstPick, current.c_str(), 1);
+  setenv(kAsked, wanted.c_str(), 1);
   execv("/proc/self/exe", argv);
-  // Still here: the program could not be run again; go on with the kernels in use.
+  const int error = errno;
+  // Still here: the program could not be run again; go on with the kernels in use, as they were.
+  if (userCore)
+    setenv("OPENBLAS_CORETYPE", before.c_str(), 1);
+  else
+    unsetenv("OPENBLAS_CORETYPE");
   unsetenv(kFirstPick);
-  return line + "; could not run again with OPENBLAS_CORETYPE=" + wanted + " (" + std::strerror(errno) + ")";
+  unsetenv(kAsked);
+  return line + "; could not run again with OPENBLAS_CORETYPE=" + wanted + " (" + std::strerror(error) + ")";
 }
 
 } // namespace quiver

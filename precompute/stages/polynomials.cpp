@@ -17,11 +17,11 @@ EnergyPolynomial computeEnergyPolynomial(MPI_Comm comm, const TetMesh& mesh, con
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   const int r = static_cast<int>(basis.cols());
-  ReducedEnergyRows rows(basis);
-  const int N = rows.columns();
   std::vector<int> mine;
   for (int t = 0; t < mesh.tetCount(); ++t)
     if (tetPart[t] == rank) mine.push_back(t);
+  ReducedEnergyRows rows(basis, mesh, mine);
+  const int N = rows.columns();
 
   const TetElements elements = computeTetElements(mesh);
   const int block = std::max(1, settings.tetsPerBlock);

@@ -277,7 +277,12 @@ struct StepManyWork {
 void stepManyJob(void* data, int job) {
   const StepManyWork& w = *static_cast<const StepManyWork*>(data);
   if (job < 0 || job >= w.jobs) return;
-  const auto bound = [&](int j) { return static_cast<int>(static_cast<long long>(w.count) * j / w.jobs); };
+  // Cut on multiples of a group, so that a crowd of groupable instances forms the same groups, and
+  // so the same bits, whatever the number of jobs.
+  const long long groups = (w.count + quiver::rt::ReducedPolynomial::kLanes - 1) / quiver::rt::ReducedPolynomial::kLanes;
+  const auto bound = [&](int j) {
+    return static_cast<int>(std::min<long long>(w.count, groups * j / w.jobs * quiver::rt::ReducedPolynomial::kLanes));
+  };
   quiver::rt::stepManyRange(w.instances, bound(job), bound(job + 1), w.scratch + w.scratchPerJob * job, w.statuses);
 }
 

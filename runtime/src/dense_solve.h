@@ -9,8 +9,9 @@ namespace quiver::rt {
 
 // Solves A x = b for symmetric positive definite A (row-major, n x n; only its upper triangle is
 // read, and it is overwritten by the factor U of A = U^T U). b is overwritten by x. Returns false,
-// leaving A and b spoiled, when A is not positive definite. Right-looking, row by row: every inner
-// loop is an axpy along a row, which vectorises without reordering any sum.
+// leaving A and b spoiled, when A is not positive definite. Right-looking, row by row: the
+// factorisation's and the forward solve's inner loops are axpys along a row, which vectorise
+// without reordering any sum.
 inline bool choleskySolve(double* A, double* b, int n) {
   for (int j = 0; j < n; ++j) {
     double* rowJ = A + j * n;

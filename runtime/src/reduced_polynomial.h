@@ -32,8 +32,8 @@ public:
   void evaluate(const double* q, double* energy, double* force, double* stiffness, double* scratch) const;
 
   // The same for up to kLanes states at once (reduced_polynomial_lanes.cpp): each coefficient is
-  // read once for all of them and multiplies a vector of kLanes values, one per state, so a group
-  // costs about what one state costs with the coefficients in L1. Entry i of q, energy, force and
+  // read once for all of them and multiplies a vector of kLanes values, one per state: the work is
+  // bound by arithmetic, not by streaming the coefficients from L2 as one state's is. Entry i of q, energy, force and
   // stiffness belongs to state i < count (none may be null). The sums run in another order than
   // evaluate()'s, so results agree with it to rounding, not bit for bit. `scratch`:
   // laneScratchSize(r) doubles, 64-byte aligned.

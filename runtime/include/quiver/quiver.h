@@ -234,10 +234,12 @@ QV_API void qv_instance_last_step(const qv_instance* instance, qv_step_report* r
    QV_SOLVER_NEWTON step with one iteration, and the first of a QV_SOLVER_MINIMIZE step's (its
    later ones depend on each instance's own line search and run one by one). The sums run in another
    order than one instance's, so states agree with qv_instance_step() to rounding, not bit for bit
-   (docs/architecture.md, "Many instances"). Instances in a qv_world are stepped by the world.
+   (docs/architecture.md, "Many instances"); they do not depend on the number of jobs when every
+   instance is groupable. Do not pass instances that are in a qv_world: the world steps them.
 
    No allocation: `scratch` (64-byte aligned) holds qv_instances_step_scratch_size(model, jobs)
-   bytes. No threads: with `jobs` not NULL the instances are cut into jobs->count contiguous ranges,
+   bytes. No threads: with `jobs` not NULL the instances are cut into jobs->count contiguous ranges
+   (on multiples of 8),
    and jobs->run(jobs->user, job, job_data, jobs->count) must call job(job_data, i) once for each i,
    on any threads, and return when all have run. NULL: one job on the calling thread. The same
    instance may not appear twice. statuses[i] (when not NULL) receives instances[i]'s status.
