@@ -1,9 +1,10 @@
 #!/usr/bin/python3
-"""The runtime's speed for r = 10, 20, 30, 40, 60 on one core, against the core's FMA peak and
-against Vega FEM's way of stepping (../shared/tools/vega_like_step.cpp, compiled here at bench time
-with -O3 -march=native, never copied into the project), both measured in the same run on the same
-CPU. Bakes a 1 x 0.1 x 0.1 cantilever (40 x 4 x 4 cells) at each r, runs bench_runtime on the models,
-prints the CPU, the BLAS core the bake's OpenBLAS picks, and a markdown table (the one in bench/README.md).
+"""The runtime's speed for r = 10, 20, 30, 40, 60 on one core, against the core's FMA peak, against
+a plain read of the bytes one evaluation streams, and against Vega FEM's way of stepping
+(../shared/tools/vega_like_step.cpp, compiled here at bench time with -O3 -march=native, never copied
+into the project), all measured in the same run on the same CPU. Bakes a 1 x 0.1 x 0.1 cantilever
+(40 x 4 x 4 cells) at each r, runs bench_runtime on the models, prints the CPU, the BLAS core the
+bake's OpenBLAS picks, and markdown tables (the ones in bench/README.md).
 
     /usr/bin/python3 bench/runtime.py --build build/release [--shared ../shared]
 """
@@ -79,7 +80,7 @@ def main():
     peak_gflops = peak["GFLOPS"] / 1e9 if peak else float("nan")
     cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")), "?")
     print(f"CPU: {cpu}; OpenBLAS core: {blas_core()}")
-    print(f"Peak FMA throughput of this core, measured in the same run: {peak_gflops:.1f} GFLOP/s (AVX-512, double)\n")
+    print(f"Peak FMA throughput of this core, measured in the same run: {peak_gflops:.1f} GFLOP/s (double, its widest vectors)\n")
     print("| r | force (us) | force + stiffness (us) | Newmark step, fixed Newton (us) | Vega-like step, same run (us) "
           "| x Vega | Newmark step, minimise (us) | its Newton iterations | evaluation GFLOP/s | fraction of peak |")
     print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
@@ -90,12 +91,28 @@ def main():
         reference = vega.get(r, float("nan"))
         print(f"| {r} | {f['real_time']:.2f} | {fk['real_time']:.2f} | {newton['real_time']:.2f} | {reference:.1f} | "
               f"{reference / newton['real_time']:.1f} | {minimize['real_time']:.2f} | {minimize['newton_per_step']:.2f} | {gflops:.1f} | {gflops / peak_gflops:.0%} |")
-    for solver in ("newton", "minimize"):
-        many = get(f"ManyObjects/{solver}/r20/1000")
-        if many:
-            frame = many["real_time"]
-            print(f"\n1000 objects of r = 20 under gravity, --solver {solver}: {frame:.2f} ms per frame on one core "
-                  f"({16.667 / frame:.1f}x inside a 60 Hz frame's 16.7 ms).")
+    print("\nCoefficient precision and the memory floor (force + stiffness; *stream* reads the same bytes as "
+          "doubles, same run):\n")
+    print("| r | coefficients f64 (MB) | evaluation f64 (us) | stream f64 (us) | f64 / stream | evaluation f32 (us) "
+          "| stream f32 (us) | f32 / stream | f32 speed-up | Newmark step f64 (us) | Newmark step f32 (us) |")
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for r in RANKS:
+        e64, e32 = get(f"Evaluate/force+stiffness/r{r}"), get(f"Evaluate/force+stiffness/f32/r{r}")
+        s64, s32 = get(f"Stream/f64/r{r}"), get(f"Stream/f32/r{r}")
+        n64, n32 = get(f"Step/newton/r{r}"), get(f"Step/newton/f32/r{r}")
+        print(f"| {r} | {s64['bytes'] / 1e6:.2f} | {e64['real_time']:.2f} | {s64['real_time']:.2f} | "
+              f"{e64['real_time'] / s64['real_time']:.1f} | {e32['real_time']:.2f} | {s32['real_time']:.2f} | "
+              f"{e32['real_time'] / s32['real_time']:.1f} | {e64['real_time'] / e32['real_time']:.2f} | "
+              f"{n64['real_time']:.2f} | {n32['real_time']:.2f} |")
+    print("\nMany objects: 1000 instances per frame on one core, each under its own push (bench/runtime.cpp):\n")
+    print("| r | solver | one by one (ms per frame) | qv_instances_step (ms per frame) | speed-up | resets |")
+    print("|---:|---|---:|---:|---:|---:|")
+    for r in (20, 30):
+        for solver in ("newton", "minimize"):
+            alone, together = get(f"ManyObjects/{solver}/one-by-one/r{r}/1000"), get(f"ManyObjects/{solver}/together/r{r}/1000")
+            if alone and together:
+                print(f"| {r} | {solver} | {alone['real_time']:.2f} | {together['real_time']:.2f} | "
+                      f"{alone['real_time'] / together['real_time']:.2f} | {int(alone['resets'] + together['resets'])} |")
 
 
 if __name__ == "__main__":

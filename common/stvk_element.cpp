@@ -38,15 +38,24 @@ Matrix12 stvkElementTangent(const Eigen::Matrix3d& H, const Matrix34& G, double 
   return K;
 }
 
+RestDirection stvkRestDirection(const Matrix34& a, const Matrix34& G, double lambda, double mu) {
+  RestDirection d;
+  d.H = a * G.transpose();
+  d.dS = mu * (d.H + d.H.transpose()) + lambda * d.H.trace() * Eigen::Matrix3d::Identity();
+  return d;
+}
+
+Matrix34 stvkElementForceHessianAtRest(const RestDirection& a, const RestDirection& b, const Matrix34& G, double V,
+                                       double lambda, double mu) {
+  const Eigen::Matrix3d HaHb = a.H.transpose() * b.H;
+  const Eigen::Matrix3d d2S = mu * (HaHb + HaHb.transpose()) + lambda * HaHb.trace() * Eigen::Matrix3d::Identity();
+  return V * (a.H * b.dS + b.H * a.dS + d2S) * G;
+}
+
 Matrix34 stvkElementForceHessianAtRest(const Matrix34& a, const Matrix34& b, const Matrix34& G, double V,
                                        double lambda, double mu) {
-  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  const Eigen::Matrix3d Ha = a * G.transpose(), Hb = b * G.transpose();
-  const Eigen::Matrix3d dSa = mu * (Ha + Ha.transpose()) + lambda * Ha.trace() * I;
-  const Eigen::Matrix3d dSb = mu * (Hb + Hb.transpose()) + lambda * Hb.trace() * I;
-  const Eigen::Matrix3d HaHb = Ha.transpose() * Hb;
-  const Eigen::Matrix3d d2S = mu * (HaHb + HaHb.transpose()) + lambda * HaHb.trace() * I;
-  return V * (Ha * dSb + Hb * dSa + d2S) * G;
+  return stvkElementForceHessianAtRest(stvkRestDirection(a, G, lambda, mu), stvkRestDirection(b, G, lambda, mu), G, V,
+                                       lambda, mu);
 }
 
 } // namespace quiver

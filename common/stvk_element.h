@@ -41,4 +41,13 @@ Matrix12 stvkElementTangent(const Eigen::Matrix3d& H, const Matrix34& G, double 
 Matrix34 stvkElementForceHessianAtRest(const Matrix34& a, const Matrix34& b, const Matrix34& G, double V,
                                        double lambda, double mu);
 
+// The same from each direction's H and \delta S, which a caller pairing many directions on one
+// tet computes once per direction (modal derivatives' right-hand sides).
+struct RestDirection {
+  Eigen::Matrix3d H, dS;
+};
+RestDirection stvkRestDirection(const Matrix34& a, const Matrix34& G, double lambda, double mu);
+Matrix34 stvkElementForceHessianAtRest(const RestDirection& a, const RestDirection& b, const Matrix34& G, double V,
+                                       double lambda, double mu);
+
 } // namespace quiver

@@ -28,15 +28,18 @@ PetscMat rightHandSides(const TetMesh& mesh, const std::vector<Material>& perTet
   const TetElements elements = computeTetElements(mesh);
   std::vector<PetscInt> columns(P);
   for (PetscInt p = 0; p < P; ++p) columns[p] = p;
-  std::vector<Matrix34> modeOnTet(fullModes.cols());
+  std::vector<RestDirection> modeOnTet(fullModes.cols());
   Eigen::Matrix<double, 12, Eigen::Dynamic, Eigen::RowMajor> values(12, P);
   PetscInt dofs[12];
   for (int t = 0; t < mesh.tetCount(); ++t) {
     if (tetPart[t] != rank) continue;
     const Tet& tet = mesh.tets[t];
-    for (int i = 0; i < fullModes.cols(); ++i)
-      for (int a = 0; a < 4; ++a) modeOnTet[i].col(a) = fullModes.block<3, 1>(3 * tet[a], i);
     const Material& m = perTet[t];
+    for (int i = 0; i < fullModes.cols(); ++i) {  // each mode's H and delta S once per tet, not per pair
+      Matrix34 onTet;
+      for (int a = 0; a < 4; ++a) onTet.col(a) = fullModes.block<3, 1>(3 * tet[a], i);
+      modeOnTet[i] = stvkRestDirection(onTet, elements.gradients[t], m.lambda(), m.mu());
+    }
     for (PetscInt p = 0; p < P; ++p) {
       const Matrix34 f = stvkElementForceHessianAtRest(modeOnTet[pairs[p][0]], modeOnTet[pairs[p][1]],
                                                        elements.gradients[t], elements.volume[t], m.lambda(), m.mu());
