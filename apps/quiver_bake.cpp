@@ -69,6 +69,10 @@ int main(int argc, char** argv) {
                  "Default damping stored in NAME.qvr: fraction of critical at the first mode (stiffness-proportional)")
       ->capture_default_str();
   app.add_option("--time-step", s.output.model.timeStep, "Suggested time step stored in NAME.qvr, in s")->capture_default_str();
+  app.add_option("--fidelity-max-tets", s.fidelity.maxTets,
+                 "Run the fidelity report only on meshes of at most this many tets (larger: skipped, saying so)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_flag("--no-fidelity{false}", s.fidelity.enabled,
                "Skip the fidelity report (the reduced model against full-space StVK on static loads: serial, the "
                "slowest stage on large meshes)");

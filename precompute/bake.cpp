@@ -144,8 +144,12 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   const Eigen::MatrixXd fullU = layout.gatherToAll(basis.vectors);
   const EnergyPolynomial energy =
       polynomialStage(stages, ctx, in.mesh.mesh, in.perTet, partition.tetPart, fullU, polynomialInputHash(basisHash));
+  const bool small = in.mesh.mesh.tetCount() <= s.fidelity.maxTets;
+  if (s.fidelity.enabled && !small)
+    ctx.progress("fidelity: skipped: " + std::to_string(in.mesh.mesh.tetCount()) + " tets is above --fidelity-max-tets " +
+                 std::to_string(s.fidelity.maxTets) + " (its full-space solves are serial and take minutes at this size)");
   const FidelityReport fidelity =
-      s.fidelity.enabled ? fidelityStage(stages, ctx, in, fullU, modes, *archive) : FidelityReport{};
+      s.fidelity.enabled && small ? fidelityStage(stages, ctx, in, fullU, modes, *archive) : FidelityReport{};
   const std::string qvr = stages.run("export", [&] {
     return exportModel(ctx, s.output, in, layout, modes, fullU, energy, fidelity, render);
   });

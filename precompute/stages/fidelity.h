@@ -23,7 +23,8 @@
 namespace quiver {
 
 struct FidelitySettings {
-  bool enabled = true;  // --no-fidelity turns the stage off
+  bool enabled = true;    // --no-fidelity turns the stage off
+  int maxTets = 30000;    // --fidelity-max-tets: larger meshes skip it (serial sparse solves: minutes at 100k tets)
 };
 
 struct FidelityCase {

@@ -205,6 +205,11 @@ class QuiverBake(unittest.TestCase):
         p = bake(1, *common, "-o", os.path.join(self.dir, "none"))  # the helper adds --no-fidelity
         self.assertEqual(p.returncode, 0, p.stderr)
         self.assertNotIn("fidelity", p.stdout)
+        # Above --fidelity-max-tets (18 tets here) the stage is skipped, saying so, and the bake goes on.
+        p = bake(1, *common, "--fidelity-max-tets", "10", "-o", os.path.join(self.dir, "large"), fidelity=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("fidelity: skipped: 18 tets is above --fidelity-max-tets 10", p.stdout)
+        self.assertTrue(os.path.exists(os.path.join(self.dir, "large.qvr")))
 
     def test_missing_mesh_is_named(self):
         p = bake(2, os.path.join(self.dir, "none.msh"), "-o", os.path.join(self.dir, "b"))
