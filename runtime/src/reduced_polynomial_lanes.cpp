@@ -127,14 +127,19 @@ void ReducedPolynomial::evaluateLanes(const double* const* q, int count, double*
   sumOfRowsLanes(t_, r, P, ql, y3);
   std::memset(Rq, 0, sizeof(double) * r * L);
   std::memset(e, 0, sizeof(double) * L);
-  // The same assembly as evaluate(), pair by pair, per lane.
+  // K(q) state by state: its upper triangle row by row, then mirrored within the state's own
+  // matrix (writing both halves pair by pair scattered stores over all the group's matrices).
+  for (int l = 0; l < count; ++l) {
+    double* K = stiffness[l];
+    for (int a = 0, p = 0; a < r; ++a)
+      for (int b = a; b < r; ++b, ++p) K[a * r + b] = k2_[p] + y3[p * L + l] + y4[p * L + l];
+    for (int a = 0; a < r; ++a)
+      for (int b = a + 1; b < r; ++b) K[b * r + a] = K[a * r + b];
+  }
+  // The force and energy as evaluate() assembles them, pair by pair, SIMD across the states.
   for (int a = 0, p = 0; a < r; ++a)
     for (int b = a; b < r; ++b, ++p) {
       const double k2 = k2_[p], weight = a == b ? 1.0 : 2.0;
-      for (int l = 0; l < count; ++l) {
-        const double s3 = y3[p * L + l], s4 = y4[p * L + l];
-        stiffness[l][a * r + b] = stiffness[l][b * r + a] = k2 + s3 + s4;
-      }
 #pragma omp simd
       for (int l = 0; l < L; ++l) {
         const double s3 = y3[p * L + l], s4 = y4[p * L + l];
