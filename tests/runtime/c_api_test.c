@@ -1,6 +1,7 @@
 /* The C API from C: every call a C program (or an FFI) makes, on the suite's baked model.
    Exits non-zero, naming the check, on the first failure. */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -13,6 +14,12 @@
       return 1;                                                       \
     }                                                                 \
   } while (0)
+
+static int jobs_run = 0;
+static void run_jobs(void* user, qv_job_function job, void* data, int count) {
+  (void)user;
+  for (int i = 0; i < count; ++i, ++jobs_run) job(data, i);
+}
 
 int main(int argc, char** argv) {
   CHECK(argc == 2);
@@ -49,6 +56,25 @@ int main(int argc, char** argv) {
   qv_instance_energies(instance, &kinetic, &elastic);
   CHECK(kinetic == 0 && elastic == 0);
   CHECK(qv_result_string(QV_ERROR_FORMAT)[0] != '\0');
+
+  /* A crowd in one call, its pieces run by a job runner of our own (here: one after the other). */
+  qv_instance* crowd[3] = {instance, NULL, NULL};
+  CHECK(qv_instance_create(model, &config, NULL, &crowd[1]) == QV_OK);
+  CHECK(qv_instance_create(model, &config, NULL, &crowd[2]) == QV_OK);
+  const qv_job_runner jobs = {2, run_jobs, NULL};
+  const size_t bytes = qv_instances_step_scratch_size(model, jobs.count);
+  char* block = malloc(bytes + 63); /* C99 has no aligned_alloc: align by hand */
+  CHECK(block);
+  void* scratch = block + (64 - (uintptr_t)block % 64) % 64;
+  qv_step_status statuses[3];
+  for (int step = 0; step < 10; ++step) {
+    CHECK(qv_instances_step(crowd, 3, &jobs, scratch, bytes, statuses) == QV_OK);
+    CHECK(statuses[0] != QV_STEP_RESET && statuses[1] != QV_STEP_RESET && statuses[2] != QV_STEP_RESET);
+  }
+  CHECK(jobs_run == 10 * jobs.count);
+  free(block);
+  qv_instance_destroy(crowd[1]);
+  qv_instance_destroy(crowd[2]);
 
   free(positions);
   qv_instance_destroy(instance);
