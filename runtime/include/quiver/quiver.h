@@ -239,9 +239,8 @@ QV_API void qv_instance_last_step(const qv_instance* instance, qv_step_report* r
 
    No allocation: `scratch` (64-byte aligned) holds qv_instances_step_scratch_size(model, jobs)
    bytes. No threads: with `jobs` not NULL the instances are cut into jobs->count contiguous ranges
-   (on multiples of 8),
-   and jobs->run(jobs->user, job, job_data, jobs->count) must call job(job_data, i) once for each i,
-   on any threads, and return when all have run. NULL: one job on the calling thread. The same
+   (on multiples of 8), and jobs->run(jobs->user, job, job_data, jobs->count) must call
+   job(job_data, i) once for each i, on any threads, and return when all have run. NULL: one job on the calling thread. The same
    instance may not appear twice. statuses[i] (when not NULL) receives instances[i]'s status.
    QV_ERROR_INVALID_ARGUMENT: a null pointer, instances of different models, too small a scratch. */
 typedef void (*qv_job_function)(void* job_data, int job_index);
