@@ -148,8 +148,10 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   if (s.fidelity.enabled && !small)
     ctx.progress("fidelity: skipped: " + std::to_string(in.mesh.mesh.tetCount()) + " tets is above --fidelity-max-tets " +
                  std::to_string(s.fidelity.maxTets) + " (its full-space solves are serial and take minutes at this size)");
-  const FidelityReport fidelity =
-      s.fidelity.enabled && small ? fidelityStage(stages, ctx, in, fullU, modes, *archive) : FidelityReport{};
+  const bool fidelityRuns = s.fidelity.enabled && small;
+  // A resumed archive may hold an earlier bake's report: the .qvr will have none, nor may the archive.
+  if (!fidelityRuns && archive->exists("/fidelity")) archive->removeObject("/fidelity");
+  const FidelityReport fidelity = fidelityRuns ? fidelityStage(stages, ctx, in, fullU, modes, *archive) : FidelityReport{};
   const std::string qvr = stages.run("export", [&] {
     return exportModel(ctx, s.output, in, layout, modes, fullU, energy, fidelity, render);
   });

@@ -128,7 +128,7 @@ void ReducedPolynomial::evaluateLanes(const double* const* q, int count, double*
   std::memset(Rq, 0, sizeof(double) * r * L);
   std::memset(e, 0, sizeof(double) * L);
   // K(q) state by state: its upper triangle row by row, then mirrored within the state's own
-  // matrix (writing both halves pair by pair scattered stores over all the group's matrices).
+  // matrix (writing both halves pair by pair would scatter stores over all the group's matrices).
   for (int l = 0; l < count; ++l) {
     double* K = stiffness[l];
     for (int a = 0, p = 0; a < r; ++a)

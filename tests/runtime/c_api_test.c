@@ -57,24 +57,24 @@ int main(int argc, char** argv) {
   CHECK(kinetic == 0 && elastic == 0);
   CHECK(qv_result_string(QV_ERROR_FORMAT)[0] != '\0');
 
-  /* A crowd in one call, its pieces run by a job runner of our own (here: one after the other). */
-  qv_instance* crowd[3] = {instance, NULL, NULL};
-  CHECK(qv_instance_create(model, &config, NULL, &crowd[1]) == QV_OK);
-  CHECK(qv_instance_create(model, &config, NULL, &crowd[2]) == QV_OK);
+  /* A crowd in one call (9 instances: 2 jobs of a group each), its pieces run by a job runner of
+     our own (here: one after the other). */
+  enum { CROWD = 9 };
+  qv_instance* crowd[CROWD] = {instance};
+  for (int i = 1; i < CROWD; ++i) CHECK(qv_instance_create(model, &config, NULL, &crowd[i]) == QV_OK);
   const qv_job_runner jobs = {2, run_jobs, NULL};
   const size_t bytes = qv_instances_step_scratch_size(model, jobs.count);
   char* block = malloc(bytes + 63); /* C99 has no aligned_alloc: align by hand */
   CHECK(block);
   void* scratch = block + (64 - (uintptr_t)block % 64) % 64;
-  qv_step_status statuses[3];
+  qv_step_status statuses[CROWD];
   for (int step = 0; step < 10; ++step) {
-    CHECK(qv_instances_step(crowd, 3, &jobs, scratch, bytes, statuses) == QV_OK);
-    CHECK(statuses[0] != QV_STEP_RESET && statuses[1] != QV_STEP_RESET && statuses[2] != QV_STEP_RESET);
+    CHECK(qv_instances_step(crowd, CROWD, &jobs, scratch, bytes, statuses) == QV_OK);
+    for (int i = 0; i < CROWD; ++i) CHECK(statuses[i] != QV_STEP_RESET);
   }
   CHECK(jobs_run == 10 * jobs.count);
   free(block);
-  qv_instance_destroy(crowd[1]);
-  qv_instance_destroy(crowd[2]);
+  for (int i = 1; i < CROWD; ++i) qv_instance_destroy(crowd[i]);
 
   free(positions);
   qv_instance_destroy(instance);
