@@ -263,31 +263,6 @@ size_t qv_instances_step_scratch_size(const qv_model* model, int jobs) {
   return model && jobs >= 1 ? quiver::rt::stepManyScratchPerJob(*model) * static_cast<size_t>(jobs) : 0;
 }
 
-namespace {
-
-struct StepManyWork {
-  qv_instance* const* instances;
-  int count;
-  int jobs;
-  char* scratch;
-  size_t scratchPerJob;
-  qv_step_status* statuses;
-};
-
-void stepManyJob(void* data, int job) {
-  const StepManyWork& w = *static_cast<const StepManyWork*>(data);
-  if (job < 0 || job >= w.jobs) return;
-  // Cut on multiples of a group, so that a crowd of groupable instances forms the same groups, and
-  // so the same bits, whatever the number of jobs.
-  const long long groups = (w.count + quiver::rt::ReducedPolynomial::kLanes - 1) / quiver::rt::ReducedPolynomial::kLanes;
-  const auto bound = [&](int j) {
-    return static_cast<int>(std::min<long long>(w.count, groups * j / w.jobs * quiver::rt::ReducedPolynomial::kLanes));
-  };
-  quiver::rt::stepManyRange(w.instances, bound(job), bound(job + 1), w.scratch + w.scratchPerJob * job, w.statuses);
-}
-
-} // namespace
-
 qv_result qv_instances_step(qv_instance* const* instances, int count, const qv_job_runner* jobs, void* scratch,
                             size_t scratchSize, qv_step_status* statuses) {
   if (count < 0 || (count > 0 && !instances) || (jobs && (jobs->count < 1 || !jobs->run)))
@@ -299,11 +274,7 @@ qv_result qv_instances_step(qv_instance* const* instances, int count, const qv_j
   const size_t perJob = quiver::rt::stepManyScratchPerJob(*instances[0]->model);
   if (!scratch || reinterpret_cast<uintptr_t>(scratch) % 64 != 0 || scratchSize / perJob < static_cast<size_t>(jobCount))
     return QV_ERROR_INVALID_ARGUMENT;
-  StepManyWork work{instances, count, jobCount, static_cast<char*>(scratch), perJob, statuses};
-  if (jobs)
-    jobs->run(jobs->user, stepManyJob, &work, jobCount);
-  else
-    stepManyJob(&work, 0);
+  quiver::rt::stepMany(instances, count, jobs, scratch, statuses);
   return QV_OK;
 }
 

@@ -214,9 +214,13 @@ qv_step_status qv_instance::finishStep() {
   return status;
 }
 
-qv_step_status qv_instance::step() {
+void qv_instance::beginOwnStep() {
   beginStep();
   if (flying()) solveOwnContacts();
+}
+
+qv_step_status qv_instance::step() {
+  beginOwnStep();
   return finishStep();
 }
 

@@ -89,6 +89,7 @@ struct qv_instance {
   // the last: the frame's forces on q and its momenta (in flight), its contacts, its move and q's step.
   void beginStep();
   void solveOwnContacts();
+  void beginOwnStep();  // beginStep() and, in flight, solveOwnContacts(): a step outside a world, up to finishStep()
   qv_step_status finishStep();
   // The snapshot: r, then q, v, a, E(q) and the energy slack, then in flight the frame (position,
   // orientation, velocity, angular momentum, last body omega), as doubles.

@@ -11,8 +11,10 @@ namespace quiver::rt {
 // Bytes of scratch each job needs (64-byte multiple).
 size_t stepManyScratchPerJob(const qv_model& model);
 
-// Steps instances [first, last) of `instances` with `scratch` (stepManyScratchPerJob bytes,
-// 64-byte aligned); statuses[i] for each, when `statuses` is not null.
-void stepManyRange(qv_instance* const* instances, int first, int last, void* scratch, qv_step_status* statuses);
+// Steps `count` instances of one model (checked by the caller) in runner->count jobs run by
+// `runner` (null: one job, here); job j uses `scratch` (64-byte aligned) from j times
+// stepManyScratchPerJob on. statuses[i] for each, when `statuses` is not null.
+void stepMany(qv_instance* const* instances, int count, const qv_job_runner* runner, void* scratch,
+              qv_step_status* statuses);
 
 } // namespace quiver::rt
