@@ -4,6 +4,11 @@
 #include <filesystem>
 #include <memory>
 
+#include <hdf5.h>
+#include <mpi.h>
+#include <petscsys.h>
+#include <slepcsys.h>
+
 #include "precompute/archive/xdmf.h"
 #include "precompute/rigid_modes.h"
 #include "precompute/stage_runner.h"
@@ -14,6 +19,9 @@
 #ifndef QUIVER_VERSION
 #error "the build defines QUIVER_VERSION (the CMake project's version)"
 #endif
+
+extern "C" char* openblas_get_config(void);  // OpenBLAS's own, not in its cblas.h
+extern "C" char* openblas_get_corename(void);
 
 namespace quiver {
 
@@ -26,6 +34,26 @@ std::string isoNow() {
   char buf[32];
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
   return buf;
+}
+
+// What computed the numbers, for /provenance: the same inputs on other versions may differ in
+// their last bits.
+std::string libraryVersions() {
+  char petsc[128], slepc[128], mpi[MPI_MAX_LIBRARY_VERSION_STRING];
+  PetscGetVersion(petsc, sizeof petsc);
+  SlepcGetVersion(slepc, sizeof slepc);
+  int length = 0;
+  MPI_Get_library_version(mpi, &length);
+  std::string mpiLine(mpi, static_cast<size_t>(length));
+  mpiLine = mpiLine.substr(0, mpiLine.find_first_of(",\n"));
+  unsigned major = 0, minor = 0, release = 0;
+  H5get_libversion(&major, &minor, &release);
+  std::string blas = openblas_get_config();
+  std::string petscLine = petsc;
+  petscLine.erase(petscLine.find_last_not_of(' ') + 1);
+  return petscLine + "; " + slepc + "; HDF5 " + std::to_string(major) + "." + std::to_string(minor) + "." +
+         std::to_string(release) + "; " + mpiLine + "; " + blas.substr(0, blas.find(' ', blas.find(' ') + 1)) +
+         " (core " + openblas_get_corename() + ")";
 }
 
 std::string partialPath(const BakeSettings& s) { return s.output.name + ".h5.partial"; }
@@ -57,6 +85,7 @@ void finishArchive(const BakeContext& ctx, const BakeSettings& s, Archive& archi
   archive.setAttribute("/provenance", "command_line", s.commandLine);
   archive.setAttribute("/provenance", "ranks", static_cast<int64_t>(ctx.size()));
   archive.setAttribute("/provenance", "created", isoNow());
+  archive.setAttribute("/provenance", "libraries", libraryVersions());
   archive.setAttribute("/provenance", "mesh_hash", in.hash);
   for (const auto& [stage, seconds] : stages.all()) archive.setAttribute("/provenance", stage + "_seconds", seconds);
   archive.flush();

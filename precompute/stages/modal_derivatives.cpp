@@ -90,6 +90,97 @@ std::vector<PetscInt> pinnedDofs(const TetMesh& mesh, const DofLayout& layout) {
   return dofs;
 }
 
+// K X = B by Cholesky (MUMPS; -derivatives_* options), B and X this rank's rows.
+//
+// On one rank, one factorization of the distributed K. On several, parallel MUMPS would give bits
+// that change from run to run (it schedules its work as messages arrive), and SuperLU_DIST's
+// multi-right-hand-side solve corrupts its heap in Debian 12 (pdReDistribute_B_to_X). So every
+// rank factors the whole of K alone and solves its own share of the columns, whose bits depend on
+// the inputs and the rank count only (issue #16). The cost is a copy of K and its factor per rank.
+Eigen::MatrixXd solveColumns(Mat op, const Eigen::MatrixXd& B, const DofLayout& layout,
+                             const DerivativeSettings& settings) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(layout.comm(), &rank);
+  MPI_Comm_size(layout.comm(), &size);
+  const Eigen::Index total = B.cols();
+  auto solveBlocks = [&](Mat A, MPI_Comm comm, Eigen::MatrixXd& rhs, Eigen::MatrixXd& x, const DofLayout* distributed) {
+    PetscKsp ksp;
+    PC pc;
+    QV_PETSC(KSPCreate(comm, ksp.out()));
+    QV_PETSC(KSPSetOptionsPrefix(ksp, "derivatives_"));
+    QV_PETSC(KSPSetOperators(ksp, A, A));
+    QV_PETSC(KSPSetType(ksp, KSPPREONLY));
+    QV_PETSC(KSPGetPC(ksp, &pc));
+    QV_PETSC(PCSetType(pc, PCCHOLESKY));
+    QV_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+    QV_PETSC(KSPSetFromOptions(ksp));
+    for (Eigen::Index first = 0; first < rhs.cols(); first += settings.blockSize) {
+      const Eigen::Index count = std::min<Eigen::Index>(settings.blockSize, rhs.cols() - first);
+      PetscMat b, solution;
+      if (distributed) {
+        b = wrapDenseColumns(rhs, first, count, *distributed);
+        solution = wrapDenseColumns(x, first, count, *distributed);
+      } else {
+        QV_PETSC(MatCreateSeqDense(comm, rhs.rows(), count, rhs.col(first).data(), b.out()));
+        QV_PETSC(MatCreateSeqDense(comm, x.rows(), count, x.col(first).data(), solution.out()));
+      }
+      QV_PETSC(KSPMatSolve(ksp, b, solution));
+      // Every rank solves about as many columns: its own count stands for the whole.
+      if (settings.progress) settings.progress(std::min(total, (first + count) * size), total);
+    }
+  };
+  Eigen::MatrixXd X(B.rows(), total);
+  if (size == 1) {
+    Eigen::MatrixXd rhs = B;
+    solveBlocks(op, layout.comm(), rhs, X, &layout);
+    return X;
+  }
+
+  // Columns [start(p), start(p + 1)) are rank p's; rows follow PETSc's ownership ranges.
+  auto start = [&](int p) { return total * p / size; };
+  const PetscInt* ranges = nullptr;
+  QV_PETSC(MatGetOwnershipRanges(op, &ranges));
+  const Eigen::Index n = layout.globalDofs(), mine = start(rank + 1) - start(rank);
+
+  // Every rank's rows of my columns, in global row order: each rank sends each other rank its rows
+  // of that rank's columns.
+  std::vector<int> sendCounts(size), sendOffsets(size), receiveCounts(size), receiveOffsets(size);
+  std::vector<double> send, receive(static_cast<size_t>(n * mine));
+  for (int p = 0; p < size; ++p) {
+    sendOffsets[p] = static_cast<int>(send.size());
+    const Eigen::MatrixXd block = B.middleCols(start(p), start(p + 1) - start(p));
+    send.insert(send.end(), block.data(), block.data() + block.size());
+    sendCounts[p] = static_cast<int>(block.size());
+    receiveCounts[p] = static_cast<int>((ranges[p + 1] - ranges[p]) * mine);
+    receiveOffsets[p] = p == 0 ? 0 : receiveOffsets[p - 1] + receiveCounts[p - 1];
+  }
+  MPI_Alltoallv(send.data(), sendCounts.data(), sendOffsets.data(), MPI_DOUBLE, receive.data(), receiveCounts.data(),
+                receiveOffsets.data(), MPI_DOUBLE, layout.comm());
+  Eigen::MatrixXd rhs(n, mine), x(n, mine);
+  for (int p = 0; p < size; ++p)
+    rhs.middleRows(ranges[p], ranges[p + 1] - ranges[p]) =
+        Eigen::Map<const Eigen::MatrixXd>(receive.data() + receiveOffsets[p], ranges[p + 1] - ranges[p], mine);
+
+  PetscMat whole;  // this rank's own copy of the whole matrix, on a communicator of one
+  QV_PETSC(MatCreateRedundantMatrix(op, size, MPI_COMM_NULL, MAT_INITIAL_MATRIX, whole.out()));
+  solveBlocks(whole, PetscObjectComm(reinterpret_cast<PetscObject>(static_cast<Mat>(whole))), rhs, x, nullptr);
+
+  // And back: rank p gets its rows of my columns.
+  send.clear();
+  for (int p = 0; p < size; ++p) {
+    sendOffsets[p] = static_cast<int>(send.size());
+    const Eigen::MatrixXd block = x.middleRows(ranges[p], ranges[p + 1] - ranges[p]);
+    send.insert(send.end(), block.data(), block.data() + block.size());
+    sendCounts[p] = static_cast<int>(block.size());
+    receiveCounts[p] = static_cast<int>(layout.localDofs() * (start(p + 1) - start(p)));
+    receiveOffsets[p] = p == 0 ? 0 : receiveOffsets[p - 1] + receiveCounts[p - 1];
+  }
+  receive.resize(static_cast<size_t>(layout.localDofs() * total));
+  MPI_Alltoallv(send.data(), sendCounts.data(), sendOffsets.data(), MPI_DOUBLE, receive.data(), receiveCounts.data(),
+                receiveOffsets.data(), MPI_DOUBLE, layout.comm());
+  return Eigen::Map<const Eigen::MatrixXd>(receive.data(), layout.localDofs(), total);
+}
+
 } // namespace
 
 ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<Material>& perTet,
@@ -122,25 +213,7 @@ ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<
     solveFor = b;
   }
 
-  PetscKsp ksp;
-  PC pc;
-  QV_PETSC(KSPCreate(layout.comm(), ksp.out()));
-  QV_PETSC(KSPSetOptionsPrefix(ksp, "derivatives_"));
-  QV_PETSC(KSPSetOperators(ksp, op, op));
-  QV_PETSC(KSPSetType(ksp, KSPPREONLY));
-  QV_PETSC(KSPGetPC(ksp, &pc));
-  QV_PETSC(PCSetType(pc, PCCHOLESKY));
-  QV_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
-  QV_PETSC(KSPSetFromOptions(ksp));
-  out.vectors.resize(layout.localDofs(), static_cast<Eigen::Index>(out.pairs.size()));
-  const Eigen::Index total = out.vectors.cols();
-  for (Eigen::Index first = 0; first < total; first += settings.blockSize) {
-    const Eigen::Index count = std::min<Eigen::Index>(settings.blockSize, total - first);
-    PetscMat rhs = wrapDenseColumns(solveFor, first, count, layout);
-    PetscMat solution = wrapDenseColumns(out.vectors, first, count, layout);
-    QV_PETSC(KSPMatSolve(ksp, rhs, solution));
-    if (settings.progress) settings.progress(first + count, total);
-  }
+  out.vectors = solveColumns(op, solveFor, layout, settings);
   if (freeObject) out.vectors -= rigid * innerProducts(rigid, multiply(mass, out.vectors, layout), layout.comm());
 
   // Normwise backward error against the unpinned system and the projected right-hand side,

@@ -2,7 +2,9 @@
 // Stage "derivatives": modal derivatives K Psi_ij = -d^2R[phi_i, phi_j] for i <= j <= k (Barbič &
 // James 2005), the second derivative of the internal force at rest applied to two modes. Each rank
 // computes the right-hand sides of its tets exactly (stvkElementForceHessianAtRest); all k(k+1)/2
-// are solved as one block with one factorization of K (MUMPS Cholesky; -derivatives_* options).
+// are solved in blocks with one Cholesky factorization of K (MUMPS; -derivatives_* options): the
+// distributed K on one rank; on several, each rank factors all of K and solves its share of the
+// right-hand sides, so that the bits do not change from run to run.
 // On a free object K is singular: the right-hand sides are projected off the rigid modes, six
 // DOFs are pinned to pick one solution, and the result is made M-orthogonal to the rigid modes.
 #include <array>

@@ -23,7 +23,7 @@ struct EigenPairs {
   Eigen::MatrixXd vectors;     // this rank's rows
 };
 
-// The `count` eigenpairs nearest `shift` by Krylov-Schur with shift-and-invert (MUMPS Cholesky),
+// The `count` eigenpairs nearest `shift` by Krylov-Schur with shift-and-invert (a direct solver),
 // M-orthogonal to `deflation`'s columns. `fromOptions` lets -eps_* / -st_* override the defaults.
 struct MonitorContext {
   const ProgressCallback* progress;
@@ -57,8 +57,17 @@ EigenPairs solveNearShift(Mat stiffness, Mat mass, const DofLayout& layout, doub
   QV_PETSC(STGetKSP(st, &ksp));
   QV_PETSC(KSPSetType(ksp, KSPPREONLY));
   QV_PETSC(KSPGetPC(ksp, &pc));
-  QV_PETSC(PCSetType(pc, PCCHOLESKY));
-  QV_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  int ranks = 1;
+  MPI_Comm_size(layout.comm(), &ranks);
+  if (ranks == 1) {
+    QV_PETSC(PCSetType(pc, PCCHOLESKY));
+    QV_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  } else {
+    // Parallel MUMPS schedules its work as messages arrive, so its solves differ in the last bits
+    // from run to run; SuperLU_DIST's static schedule gives the same bits every run (issue #16).
+    QV_PETSC(PCSetType(pc, PCLU));
+    QV_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERSUPERLU_DIST));
+  }
   std::vector<PetscVec> deflationVecs(deflation.cols());
   std::vector<Vec> raw;
   for (Eigen::Index j = 0; j < deflation.cols(); ++j) {

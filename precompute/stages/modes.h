@@ -1,10 +1,10 @@
 #pragma once
 // Stage "modes": the lowest vibration modes K phi = lambda M phi of the free DOFs, by SLEPc's
-// Krylov-Schur with shift-and-invert and a parallel direct factorization (MUMPS). On a free
-// object (no fixed vertex) K is singular: the six rigid motions are deflated (the solver works
-// M-orthogonally to them), and the shift is placed below zero at half the first elastic
-// eigenvalue, which a cheap first solve estimates; so K - sigma M is definite and as well
-// conditioned as on a clamped object.
+// Krylov-Schur with shift-and-invert and a direct factorization (MUMPS on one rank, SuperLU_DIST on
+// several: the same bits every run). On a free object (no fixed vertex) K is singular: the six
+// rigid motions are deflated (the solver works M-orthogonally to them), and the shift is placed
+// below zero at half the first elastic eigenvalue, which a cheap first solve estimates; so
+// K - sigma M is definite and as well conditioned as on a clamped object.
 // The defaults can be overridden from the command line with SLEPc's own options (-eps_*, -st_*).
 #include <string>
 #include <vector>
