@@ -1,0 +1,143 @@
+"""Flying instances of the free beam: free fall, landing on each kind of collider, a world of two,
+and the colliders' own checks."""
+import numpy as np
+import pytest
+
+import quiver
+
+G = quiver.STANDARD_GRAVITY
+
+
+def flyer(free_model, height):
+    """A free beam at rest with its centre of mass `height` above the ground, under gravity."""
+    s = quiver.Instance(free_model, free_flight=True)
+    state = s.rigid_state
+    state.position = [0.3, 0.05, height]
+    s.rigid_state = state
+    s.set_gravity((0, 0, -G))
+    return s
+
+
+def box_mesh(center, half):
+    """A closed box as a triangle mesh, counter-clockwise seen from outside."""
+    corners = np.array([(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float) * half + center
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    return corners, [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))]
+
+
+def test_free_fall_is_a_parabola_and_keeps_the_shape(free_model):
+    s = flyer(free_model, 0.3)
+    assert s.flying and s.rigid_state.orientation.tolist() == [1, 0, 0, 0]
+    steps = 120
+    s.step(steps)
+    t = steps * s.time_step
+    state = s.rigid_state
+    # A uniform field moves the frame only: v = -g t exactly, the drop within one step's g h t of
+    # the parabola, no spin, no deformation.
+    np.testing.assert_allclose(state.linear_velocity, [0, 0, -G * t], rtol=1e-12, atol=1e-12)
+    assert abs(state.position[2] - (0.3 - G * t * t / 2)) <= G * s.time_step * t
+    np.testing.assert_allclose(state.position[:2], [0.3, 0.05], atol=1e-12)
+    np.testing.assert_allclose(state.angular_velocity, 0, atol=1e-12)
+    assert np.abs(s.q).max() < 1e-12
+
+
+def test_rigid_state_round_trips_and_is_checked(free_model):
+    s = quiver.Instance(free_model, free_flight=True)
+    turn = quiver.RigidState(position=(1, 2, 3), orientation=(2, 0, 0, 0), linear_velocity=(0, 1, 0),
+                             angular_velocity=(0, 0, 0.5))
+    s.rigid_state = turn
+    back = s.rigid_state
+    np.testing.assert_allclose(back.position, [1, 2, 3])
+    np.testing.assert_allclose(back.orientation, [1, 0, 0, 0])  # normalised
+    np.testing.assert_allclose(back.angular_velocity, [0, 0, 0.5], atol=1e-12)
+    with pytest.raises(ValueError, match="non-zero quaternion"):
+        quiver.RigidState(orientation=(0, 0, 0, 0))
+    with pytest.raises(ValueError, match="NaN"):
+        turn.position = (0, np.nan, 0)
+
+
+@pytest.mark.parametrize("ground", [
+    quiver.Plane((0, 0, 1), 0.0),
+    quiver.Plane((0, 0, 2), 0.0, friction=0.8),  # any length of normal
+    quiver.Box((0.3, 0.05, -0.5), (1, 1, 0.5)),
+    quiver.Sphere((0.3, 0.05, -100), 100),
+    quiver.Capsule((-1, 0.05, -0.5), (2, 0.05, -0.5), 0.5),
+    quiver.MeshCollider(quiver.TriangleMesh(*box_mesh((0, 0, 0), (0.7, 1, 0.5))), (0.3, 0.05, -0.5)),
+], ids=["plane", "plane-long-normal", "box", "sphere", "capsule", "mesh"])
+def test_a_dropped_beam_comes_to_rest_on_the_ground(free_model, ground):
+    s = flyer(free_model, 0.3)  # its underside 0.25 above the ground's top at z = 0
+    s.set_colliders([ground])
+    steps = 120
+    for _ in range(steps):
+        assert s.step() != quiver.StepStatus.RESET
+    low = s.positions()[:, 2].min()
+    # On it, not through it: the documented rest sinks 1.5 mm on this bar at 1/60 s.
+    assert -0.01 < low < 0.005, low
+    assert np.abs(s.rigid_state.linear_velocity).max() < 1e-3
+    contacts = s.contacts()
+    assert contacts.dtype == quiver.CONTACT_DTYPE and len(contacts) > 0
+    assert np.all(contacts["collider"] == 0) and np.all(contacts["other"] == -1)
+    assert np.all(contacts["normal"][:, 2] > 0.99)
+    # At rest the ground carries the weight: the step's impulses add up to m g h.
+    np.testing.assert_allclose(contacts["impulse"].sum(axis=0) / s.time_step, [0, 0, free_model.info.total_mass * G],
+                               rtol=0, atol=0.02 * free_model.info.total_mass * G)
+
+
+def test_without_the_ground_it_falls_through(free_model):
+    s = flyer(free_model, 0.3)
+    s.set_colliders([quiver.Plane((0, 0, 1), 0.0)])
+    s.set_colliders([])
+    s.step(60)
+    assert s.positions()[:, 2].max() < -1 and len(s.contacts()) == 0
+
+
+def test_a_world_stacks_one_beam_on_another(free_model):
+    world = quiver.World()
+    low, high = flyer(free_model, 0.06), flyer(free_model, 0.25)
+    assert (world.add(low), world.add(high)) == (0, 1) and len(world) == 2
+    world.set_colliders([quiver.Plane((0, 0, 1), 0.0)])
+    for _ in range(180):
+        assert world.step() == 0
+    # The lower rests on the ground, the upper on the lower (0.1 m thick), neither through.
+    assert -0.01 < low.positions()[:, 2].min() < 0.005
+    assert high.rigid_state.position[2] == pytest.approx(0.15, abs=0.02)
+    contacts = world.contacts()
+    between = contacts[contacts["other"] >= 0]
+    assert len(between) > 0 and set(between["instance"]) <= {0, 1}
+    assert world.instances == [low, high]
+    with pytest.raises(ValueError, match="already in a World"):
+        world.add(low)
+    with pytest.raises(ValueError, match="is in a World"):
+        quiver.step_many([low])
+    with pytest.raises(ValueError, match="only flying instances"):
+        world.add(quiver.Instance(free_model))
+    with pytest.raises(ValueError, match="same time step"):
+        world.add(quiver.Instance(free_model, free_flight=True, time_step=0.01))
+    with pytest.raises(ValueError, match="restitution"):
+        quiver.World(restitution=2)
+
+
+def test_colliders_check_their_shape(free_model):
+    with pytest.raises(ValueError, match="normal must not be zero"):
+        quiver.Plane((0, 0, 0))
+    with pytest.raises(ValueError, match="radius must be positive"):
+        quiver.Sphere((0, 0, 0), -1)
+    with pytest.raises(ValueError, match="half extent"):
+        quiver.Box((0, 0, 0), (1, 0, 1))
+    with pytest.raises(ValueError, match="restitution must be between 0 and 1"):
+        quiver.Plane((0, 0, 1), restitution=1.5)
+    with pytest.raises(ValueError, match="center contains NaN"):
+        quiver.Sphere((0, np.nan, 0), 1)
+    corners, triangles = box_mesh((0, 0, 0), (1, 1, 1))
+    mesh = quiver.TriangleMesh(corners, triangles)
+    assert (mesh.vertex_count, mesh.triangle_count) == (8, 12)
+    with pytest.raises(quiver.FormatError) as open_mesh:  # one triangle missing: not closed
+        quiver.TriangleMesh(corners, triangles[:-1])
+    assert "edge" in str(open_mesh.value)
+    with pytest.raises(IndexError, match="names vertex 8"):
+        quiver.TriangleMesh(corners, [(0, 1, 8)])
+    s = quiver.Instance(free_model, free_flight=True)
+    with pytest.raises(TypeError, match=r"colliders\[1\] must be a quiver collider"):
+        s.set_colliders([quiver.Plane((0, 0, 1)), "floor"])
+    plane = quiver.Plane((0, 0, 1), 2.0, velocity=(0, 0, 1))
+    assert plane.type == "plane" and plane.offset == 2.0 and plane.velocity.tolist() == [0, 0, 1]
