@@ -49,7 +49,7 @@ class DebianPackage(unittest.TestCase):
         for path in ("/usr/bin/quiver", "/usr/bin/quiver-bake", "/usr/bin/quiver-mesh", "/usr/bin/quiver-view",
                      "/usr/include/quiver/quiver.h", "/usr/lib/libquiver_runtime.so.0.6", "/usr/lib/libquiver_runtime.a",
                      "/usr/lib/cmake/Quiver/QuiverConfig.cmake", "/usr/lib/pkgconfig/quiver.pc",
-                     "/usr/share/doc/quiver/copyright"):
+                     "/usr/share/doc/quiver/copyright", "/usr/lib/python3/dist-packages/quiver/__init__.py"):
             self.assertIn(path, files)
 
     def test_apt_resolves_its_dependencies(self):
@@ -93,6 +93,7 @@ build/consumer_cpp beam.qvr
 build/consumer_c beam.qvr 30
 cc -std=c99 /tmp/embed.c $(pkg-config --cflags --libs quiver) -o embed_pc
 ./embed_pc beam.qvr 30
+python3 -c "import quiver; print('python:', quiver.__version__, quiver.Model('beam.qvr').info.r)"
 """)
         p = subprocess.run(["mmdebstrap", "--variant=apt", "--include=cmake,make,g++,pkg-config",
                             f"--customize-hook=upload {self.deb} /tmp/quiver.deb",
@@ -105,6 +106,7 @@ cc -std=c99 /tmp/embed.c $(pkg-config --cflags --libs quiver) -o embed_pc
         self.assertEqual(p.returncode, 0, p.stdout[-3000:] + p.stderr[-3000:])
         self.assertIn("from C++: r = 10", p.stdout + p.stderr)
         self.assertEqual((p.stdout + p.stderr).count("after 30 frames"), 2)
+        self.assertIn(f"python: {VERSION} 10", p.stdout + p.stderr)
 
 
 if __name__ == "__main__":

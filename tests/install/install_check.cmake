@@ -24,6 +24,14 @@ foreach(file bin/quiver bin/quiver-mesh bin/quiver-bake bin/quiver-view include/
   endif()
 endforeach()
 run(${prefix}/bin/quiver info ${MODEL})
+if(EXISTS ${BUILD}/python/quiver)  # the Python module, where Debian's python3 looks under a prefix
+  run(${CMAKE_COMMAND} -E env PYTHONPATH=${prefix}/lib/python3/dist-packages
+    /usr/bin/python3 -c "print(__import__('quiver').Model('${MODEL}').info.r)")  # no ';': a CMake list
+  string(STRIP "${out}" r)
+  if(NOT r STREQUAL "10")
+    message(FATAL_ERROR "the installed Python module read r = '${r}'")
+  endif()
+endif()
 
 # The CMake package, shared and static, from C and C++.
 foreach(variant shared static)
