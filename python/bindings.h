@@ -128,8 +128,11 @@ class World {
   World(const World&) = delete;
   World& operator=(const World&) = delete;
   qv_world* get() const { return world_; }
+  // The handle for a call; raises while another thread steps this world with the GIL released.
+  qv_world* use() const;
 
   const qv_world_config config;
+  bool busy = false;  // being stepped without the GIL (only read and written with it held)
   std::vector<py::object> instances;  // keeps them alive while the world points to them
   ColliderSet colliders;
 

@@ -36,6 +36,11 @@ BusyGuard::~BusyGuard() {
   for (Instance* s : instances_) s->busy = false;
 }
 
+qv_world* World::use() const {
+  if (busy) throw std::runtime_error("this world is being stepped on another thread (World.step)");
+  return world_;
+}
+
 World::World(const qv_world_config& settings) : config(settings) {
   const qv_result result = qv_world_create(&config, nullptr, &world_);
   if (result == QV_ERROR_OUT_OF_MEMORY) throw std::bad_alloc();
@@ -298,6 +303,7 @@ colliders persist. Positions and normals are in the world (in flight, carried by
                              "largest stable step of central differences at rest, s")
       .def("step", [](Instance& self, long long count) {
              if (count < 0) throw py::value_error("count must be >= 0");
+             if (self.world) throw py::value_error("this instance is in a World, which steps it (World.step)");
              qv_step_status status = QV_STEP_OK;
              BusyGuard guard({&self});
              py::gil_scoped_release release;
@@ -477,7 +483,7 @@ steps every instance once and returns how many reset. The world keeps its instan
         if (!self.instances.empty() && self.instances[0].cast<Instance&>().config.time_step != s.config.time_step)
           throw py::value_error("every instance of a World must have the same time step");
         int index = -1;
-        if (qv_world_add(self.get(), s.use(), &index) != QV_OK) throw py::value_error("qv_world_add refused the instance");
+        if (qv_world_add(self.use(), s.use(), &index) != QV_OK) throw py::value_error("qv_world_add refused the instance");
         s.world = &self;
         self.instances.push_back(std::move(instance));
         return index;
@@ -490,18 +496,24 @@ steps every instance once and returns how many reset. The world keeps its instan
       .def("__len__", [](const World& self) { return self.instances.size(); })
       .def("set_colliders", [](World& self, py::handle colliders) {
         ColliderSet set = ColliderSet::from(colliders);
-        if (qv_world_set_colliders(self.get(), set.raw.data(), static_cast<int>(set.raw.size())) != QV_OK)
+        if (qv_world_set_colliders(self.use(), set.raw.data(), static_cast<int>(set.raw.size())) != QV_OK)
           throw py::value_error("qv_world_set_colliders refused the colliders");
         self.colliders = std::move(set);
       }, py::arg("colliders"), "The world's colliders (a list; copied: to move one, pass a new list).")
       .def("step", [](World& self) {
         std::vector<Instance*> members;
         for (const py::object& s : self.instances) members.push_back(&s.cast<Instance&>());
+        qv_world* world = self.use();
         BusyGuard guard(members);
+        struct Stepping {  // the world's own colliders and members must not change meanwhile
+          World& w;
+          ~Stepping() { w.busy = false; }
+        } stepping{self};
+        self.busy = true;
         py::gil_scoped_release release;
-        return qv_world_step(self.get());
+        return qv_world_step(world);
       }, "Steps every instance once; returns how many reset (never expected).")
-      .def("contacts", [](const World& self) { return contactArray(static_cast<const qv_world*>(self.get()), qv_world_contacts); },
+      .def("contacts", [](const World& self) { return contactArray(static_cast<const qv_world*>(self.use()), qv_world_contacts); },
            "The last step's contacts, as Instance.contacts(); `instance` and `other` say who touched whom.");
 }
 

@@ -1,5 +1,8 @@
 #include "precompute/stages/modal_derivatives.h"
 
+#include <algorithm>
+#include <climits>
+
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <petscksp.h>
@@ -90,95 +93,125 @@ std::vector<PetscInt> pinnedDofs(const TetMesh& mesh, const DofLayout& layout) {
   return dofs;
 }
 
-// K X = B by Cholesky (MUMPS; -derivatives_* options), B and X this rank's rows.
+// A Cholesky solver of A (MUMPS; -derivatives_* options) on A's communicator.
+PetscKsp choleskySolver(Mat A) {
+  PetscKsp ksp;
+  PC pc;
+  QV_PETSC(KSPCreate(PetscObjectComm(reinterpret_cast<PetscObject>(A)), ksp.out()));
+  QV_PETSC(KSPSetOptionsPrefix(ksp, "derivatives_"));
+  QV_PETSC(KSPSetOperators(ksp, A, A));
+  QV_PETSC(KSPSetType(ksp, KSPPREONLY));
+  QV_PETSC(KSPGetPC(ksp, &pc));
+  QV_PETSC(PCSetType(pc, PCCHOLESKY));
+  QV_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  QV_PETSC(KSPSetFromOptions(ksp));
+  return ksp;
+}
+
+// MPI_Alltoallv of doubles; the counts (per rank) must fit MPI's int, which rounds of a few columns do.
+std::vector<double> exchange(const std::vector<double>& send, const std::vector<size_t>& sendCounts,
+                             const std::vector<size_t>& receiveCounts, MPI_Comm comm) {
+  const size_t size = sendCounts.size();
+  std::vector<int> sc(size), so(size), rc(size), ro(size);
+  size_t sent = 0, received = 0;
+  for (size_t p = 0; p < size; ++p) {
+    if (sent + sendCounts[p] > INT_MAX || received + receiveCounts[p] > INT_MAX)
+      throw std::runtime_error("modal derivatives: a block of right-hand sides is too large for one MPI exchange");
+    so[p] = static_cast<int>(sent);
+    sc[p] = static_cast<int>(sendCounts[p]);
+    ro[p] = static_cast<int>(received);
+    rc[p] = static_cast<int>(receiveCounts[p]);
+    sent += sendCounts[p];
+    received += receiveCounts[p];
+  }
+  std::vector<double> receive(received);
+  MPI_Alltoallv(send.data(), sc.data(), so.data(), MPI_DOUBLE, receive.data(), rc.data(), ro.data(), MPI_DOUBLE, comm);
+  return receive;
+}
+
+// K X = B (B and X this rank's rows), in rounds of settings.blockSize right-hand sides.
 //
 // On one rank, one factorization of the distributed K. On several, parallel MUMPS would give bits
 // that change from run to run (it schedules its work as messages arrive), and SuperLU_DIST's
 // multi-right-hand-side solve corrupts its heap in Debian 12 (pdReDistribute_B_to_X). So every
 // rank factors the whole of K alone and solves its own share of the columns, whose bits depend on
-// the inputs and the rank count only (issue #16). The cost is a copy of K and its factor per rank.
-Eigen::MatrixXd solveColumns(Mat op, const Eigen::MatrixXd& B, const DofLayout& layout,
-                             const DerivativeSettings& settings) {
+// the inputs and the rank count only (issue #16). The cost is a copy of K and its factor per rank;
+// -derivatives_distributed goes back to one distributed factorization (less memory per rank).
+Eigen::MatrixXd solveColumns(Mat op, Eigen::MatrixXd B, const DofLayout& layout, const DerivativeSettings& settings) {
   int rank = 0, size = 1;
   MPI_Comm_rank(layout.comm(), &rank);
   MPI_Comm_size(layout.comm(), &size);
-  const Eigen::Index total = B.cols();
-  auto solveBlocks = [&](Mat A, MPI_Comm comm, Eigen::MatrixXd& rhs, Eigen::MatrixXd& x, const DofLayout* distributed) {
-    PetscKsp ksp;
-    PC pc;
-    QV_PETSC(KSPCreate(comm, ksp.out()));
-    QV_PETSC(KSPSetOptionsPrefix(ksp, "derivatives_"));
-    QV_PETSC(KSPSetOperators(ksp, A, A));
-    QV_PETSC(KSPSetType(ksp, KSPPREONLY));
-    QV_PETSC(KSPGetPC(ksp, &pc));
-    QV_PETSC(PCSetType(pc, PCCHOLESKY));
-    QV_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
-    QV_PETSC(KSPSetFromOptions(ksp));
-    for (Eigen::Index first = 0; first < rhs.cols(); first += settings.blockSize) {
-      const Eigen::Index count = std::min<Eigen::Index>(settings.blockSize, rhs.cols() - first);
-      PetscMat b, solution;
-      if (distributed) {
-        b = wrapDenseColumns(rhs, first, count, *distributed);
-        solution = wrapDenseColumns(x, first, count, *distributed);
-      } else {
-        QV_PETSC(MatCreateSeqDense(comm, rhs.rows(), count, rhs.col(first).data(), b.out()));
-        QV_PETSC(MatCreateSeqDense(comm, x.rows(), count, x.col(first).data(), solution.out()));
-      }
-      QV_PETSC(KSPMatSolve(ksp, b, solution));
-      // Every rank solves about as many columns: its own count stands for the whole.
-      if (settings.progress) settings.progress(std::min(total, (first + count) * size), total);
-    }
-  };
+  PetscBool distributed = PETSC_FALSE;
+  QV_PETSC(PetscOptionsGetBool(nullptr, "derivatives_", "-distributed", &distributed, nullptr));
+  const Eigen::Index total = B.cols(), block = settings.blockSize;
   Eigen::MatrixXd X(B.rows(), total);
-  if (size == 1) {
-    Eigen::MatrixXd rhs = B;
-    solveBlocks(op, layout.comm(), rhs, X, &layout);
+  if (size == 1 || distributed) {
+    PetscKsp ksp = choleskySolver(op);
+    for (Eigen::Index first = 0; first < total; first += block) {
+      const Eigen::Index count = std::min(block, total - first);
+      PetscMat b = wrapDenseColumns(B, first, count, layout), x = wrapDenseColumns(X, first, count, layout);
+      QV_PETSC(KSPMatSolve(ksp, b, x));
+      if (settings.progress) settings.progress(first + count, total);
+    }
     return X;
   }
 
-  // Columns [start(p), start(p + 1)) are rank p's; rows follow PETSc's ownership ranges.
-  auto start = [&](int p) { return total * p / size; };
-  const PetscInt* ranges = nullptr;
-  QV_PETSC(MatGetOwnershipRanges(op, &ranges));
-  const Eigen::Index n = layout.globalDofs(), mine = start(rank + 1) - start(rank);
-
-  // Every rank's rows of my columns, in global row order: each rank sends each other rank its rows
-  // of that rank's columns.
-  std::vector<int> sendCounts(size), sendOffsets(size), receiveCounts(size), receiveOffsets(size);
-  std::vector<double> send, receive(static_cast<size_t>(n * mine));
-  for (int p = 0; p < size; ++p) {
-    sendOffsets[p] = static_cast<int>(send.size());
-    const Eigen::MatrixXd block = B.middleCols(start(p), start(p + 1) - start(p));
-    send.insert(send.end(), block.data(), block.data() + block.size());
-    sendCounts[p] = static_cast<int>(block.size());
-    receiveCounts[p] = static_cast<int>((ranges[p + 1] - ranges[p]) * mine);
-    receiveOffsets[p] = p == 0 ? 0 : receiveOffsets[p - 1] + receiveCounts[p - 1];
-  }
-  MPI_Alltoallv(send.data(), sendCounts.data(), sendOffsets.data(), MPI_DOUBLE, receive.data(), receiveCounts.data(),
-                receiveOffsets.data(), MPI_DOUBLE, layout.comm());
-  Eigen::MatrixXd rhs(n, mine), x(n, mine);
-  for (int p = 0; p < size; ++p)
-    rhs.middleRows(ranges[p], ranges[p + 1] - ranges[p]) =
-        Eigen::Map<const Eigen::MatrixXd>(receive.data() + receiveOffsets[p], ranges[p + 1] - ranges[p], mine);
-
   PetscMat whole;  // this rank's own copy of the whole matrix, on a communicator of one
   QV_PETSC(MatCreateRedundantMatrix(op, size, MPI_COMM_NULL, MAT_INITIAL_MATRIX, whole.out()));
-  solveBlocks(whole, PetscObjectComm(reinterpret_cast<PetscObject>(static_cast<Mat>(whole))), rhs, x, nullptr);
-
-  // And back: rank p gets its rows of my columns.
-  send.clear();
-  for (int p = 0; p < size; ++p) {
-    sendOffsets[p] = static_cast<int>(send.size());
-    const Eigen::MatrixXd block = x.middleRows(ranges[p], ranges[p + 1] - ranges[p]);
-    send.insert(send.end(), block.data(), block.data() + block.size());
-    sendCounts[p] = static_cast<int>(block.size());
-    receiveCounts[p] = static_cast<int>(layout.localDofs() * (start(p + 1) - start(p)));
-    receiveOffsets[p] = p == 0 ? 0 : receiveOffsets[p - 1] + receiveCounts[p - 1];
+  PetscKsp ksp = choleskySolver(whole);
+  const MPI_Comm self = PetscObjectComm(reinterpret_cast<PetscObject>(static_cast<Mat>(whole)));
+  const PetscInt* ranges = nullptr;  // rows follow PETSc's ownership ranges
+  QV_PETSC(MatGetOwnershipRanges(op, &ranges));
+  auto rows = [&](int p) { return static_cast<Eigen::Index>(ranges[p + 1] - ranges[p]); };
+  auto start = [&](int p) { return total * p / size; };  // rank p's columns: [start(p), start(p + 1))
+  Eigen::Index most = 0;
+  for (int p = 0; p < size; ++p) most = std::max(most, start(p + 1) - start(p));
+  const Eigen::Index n = layout.globalDofs();
+  for (Eigen::Index first = 0; first < most; first += block) {
+    // This round: columns [begin(p), begin(p) + count(p)) of each rank p.
+    auto begin = [&](int p) { return start(p) + first; };
+    auto count = [&](int p) { return std::clamp<Eigen::Index>(start(p + 1) - begin(p), 0, block); };
+    const Eigen::Index mine = count(rank);
+    // Each rank's rows of my columns, in global row order.
+    std::vector<double> send;
+    std::vector<size_t> sendCounts(size), receiveCounts(size);
+    for (int p = 0; p < size; ++p) {
+      if (count(p) > 0) {  // columns of one rank are contiguous in B
+        const double* part = B.col(begin(p)).data();
+        send.insert(send.end(), part, part + B.rows() * count(p));
+      }
+      sendCounts[p] = static_cast<size_t>(B.rows() * count(p));
+      receiveCounts[p] = static_cast<size_t>(rows(p) * mine);
+    }
+    std::vector<double> received = exchange(send, sendCounts, receiveCounts, layout.comm());
+    Eigen::MatrixXd rhs(n, mine), x(n, mine);
+    for (int p = 0, offset = 0; p < size; offset += static_cast<int>(receiveCounts[p]), ++p)
+      rhs.middleRows(ranges[p], rows(p)) = Eigen::Map<const Eigen::MatrixXd>(received.data() + offset, rows(p), mine);
+    if (mine > 0) {
+      PetscMat b, solution;
+      QV_PETSC(MatCreateSeqDense(self, n, mine, rhs.data(), b.out()));
+      QV_PETSC(MatCreateSeqDense(self, n, mine, x.data(), solution.out()));
+      QV_PETSC(KSPMatSolve(ksp, b, solution));
+    }
+    // And back: each rank gets its rows of my columns.
+    send.clear();
+    for (int p = 0; p < size; ++p) {
+      const Eigen::MatrixXd part = x.middleRows(ranges[p], rows(p));
+      send.insert(send.end(), part.data(), part.data() + part.size());
+      sendCounts[p] = static_cast<size_t>(part.size());
+      receiveCounts[p] = static_cast<size_t>(B.rows() * count(p));
+    }
+    received = exchange(send, sendCounts, receiveCounts, layout.comm());
+    for (int p = 0, offset = 0; p < size; offset += static_cast<int>(receiveCounts[p]), ++p)
+      if (count(p) > 0)
+        X.middleCols(begin(p), count(p)) = Eigen::Map<const Eigen::MatrixXd>(received.data() + offset, B.rows(), count(p));
+    if (settings.progress) {
+      Eigen::Index solved = 0;
+      for (int p = 0; p < size; ++p) solved += std::min(start(p + 1) - start(p), first + block);
+      settings.progress(solved, total);
+    }
   }
-  receive.resize(static_cast<size_t>(layout.localDofs() * total));
-  MPI_Alltoallv(send.data(), sendCounts.data(), sendOffsets.data(), MPI_DOUBLE, receive.data(), receiveCounts.data(),
-                receiveOffsets.data(), MPI_DOUBLE, layout.comm());
-  return Eigen::Map<const Eigen::MatrixXd>(receive.data(), layout.localDofs(), total);
+  return X;
 }
 
 } // namespace
@@ -213,7 +246,7 @@ ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<
     solveFor = b;
   }
 
-  out.vectors = solveColumns(op, solveFor, layout, settings);
+  out.vectors = solveColumns(op, std::move(solveFor), layout, settings);
   if (freeObject) out.vectors -= rigid * innerProducts(rigid, multiply(mass, out.vectors, layout), layout.comm());
 
   // Normwise backward error against the unpinned system and the projected right-hand side,

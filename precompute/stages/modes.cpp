@@ -5,6 +5,7 @@
 #include <numeric>
 #include <sstream>
 
+#include <dlfcn.h>
 #include <slepceps.h>
 
 #include "precompute/checkpoint.h"
@@ -59,14 +60,29 @@ EigenPairs solveNearShift(Mat stiffness, Mat mass, const DofLayout& layout, doub
   QV_PETSC(KSPGetPC(ksp, &pc));
   int ranks = 1;
   MPI_Comm_size(layout.comm(), &ranks);
+  // The same bits every run (issue #16). Parallel MUMPS schedules its work as messages arrive, so its
+  // solves differ in the last bits from run to run. SuperLU_DIST's triangular solves receive from
+  // any rank in turn, which fixes the order of their sums only when there is one other rank; and
+  // they sum per-thread partial results, so one OpenMP thread per rank (a bake runs a rank per core
+  // anyway; OpenMP is SuperLU_DIST's, not ours). On more ranks every rank factors the whole of K
+  // alone (PCREDUNDANT), as the derivatives do.
   if (ranks == 1) {
     QV_PETSC(PCSetType(pc, PCCHOLESKY));
     QV_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
-  } else {
-    // Parallel MUMPS schedules its work as messages arrive, so its solves differ in the last bits
-    // from run to run; SuperLU_DIST's static schedule gives the same bits every run (issue #16).
+  } else if (ranks == 2) {
+    if (auto* setThreads = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "omp_set_num_threads")))
+      setThreads(1);
     QV_PETSC(PCSetType(pc, PCLU));
     QV_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERSUPERLU_DIST));
+  } else {
+    KSP whole;
+    PC factor;
+    QV_PETSC(PCSetType(pc, PCREDUNDANT));
+    QV_PETSC(PCRedundantSetNumber(pc, ranks));
+    QV_PETSC(PCRedundantGetKSP(pc, &whole));
+    QV_PETSC(KSPGetPC(whole, &factor));
+    QV_PETSC(PCSetType(factor, PCCHOLESKY));
+    QV_PETSC(PCFactorSetMatSolverType(factor, MATSOLVERMUMPS));
   }
   std::vector<PetscVec> deflationVecs(deflation.cols());
   std::vector<Vec> raw;

@@ -1,10 +1,10 @@
 #pragma once
 // Stage "modes": the lowest vibration modes K phi = lambda M phi of the free DOFs, by SLEPc's
 // Krylov-Schur with shift-and-invert and a direct factorization (MUMPS on one rank, SuperLU_DIST on
-// several: the same bits every run). On a free object (no fixed vertex) K is singular: the six
-// rigid motions are deflated (the solver works M-orthogonally to them), and the shift is placed
-// below zero at half the first elastic eigenvalue, which a cheap first solve estimates; so
-// K - sigma M is definite and as well conditioned as on a clamped object.
+// two, a sequential MUMPS factor per rank on more: the same bits every run). On a free object (no
+// fixed vertex) K is singular: the six rigid motions are deflated (the solver works M-orthogonally
+// to them), and the shift is placed below zero at half the first elastic eigenvalue, which a cheap
+// first solve estimates; so K - sigma M is definite and as well conditioned as on a clamped object.
 // The defaults can be overridden from the command line with SLEPc's own options (-eps_*, -st_*).
 #include <string>
 #include <vector>
@@ -49,8 +49,8 @@ std::vector<double> eigenResiduals(Mat stiffness, Mat mass, const std::vector<do
                                    const Eigen::MatrixXd& vectors, const DofLayout& layout);
 
 // Checkpoint: group /modes. Input hash: the mesh stage's, k, the PETSc/SLEPc options given, and the
-// stage's version tag.
-inline constexpr const char* kModesVersion = "modes 1";
+// stage's version tag (2: the solvers that give the same bits every run on several ranks).
+inline constexpr const char* kModesVersion = "modes 2";
 std::string modesInputHash(const std::string& meshHash, int count, const std::string& petscOptions);
 void writeModes(Archive& archive, const LinearModes& modes, const DofLayout& layout, const std::string& inputHash);
 LinearModes readModes(const Archive& archive, const DofLayout& layout);

@@ -14,9 +14,10 @@ endfunction()
 
 file(REMOVE_RECURSE ${BINARY})
 set(prefix ${BINARY}/prefix)
+string(REGEX MATCH "^[0-9]+\\.[0-9]+" soversion ${QUIVER_VERSION})
 run(${CMAKE_COMMAND} --install ${BUILD} --prefix ${prefix})
 foreach(file bin/quiver bin/quiver-mesh bin/quiver-bake bin/quiver-view include/quiver/quiver.h
-    include/quiver/quiver_config.h lib/libquiver_runtime.a lib/libquiver_runtime.so lib/libquiver_runtime.so.0.6
+    include/quiver/quiver_config.h lib/libquiver_runtime.a lib/libquiver_runtime.so lib/libquiver_runtime.so.${soversion}
     lib/cmake/Quiver/QuiverConfig.cmake lib/cmake/Quiver/QuiverConfigVersion.cmake lib/cmake/Quiver/QuiverTargets.cmake
     lib/pkgconfig/quiver.pc)
   if(NOT EXISTS ${prefix}/${file})
@@ -33,39 +34,54 @@ if(EXISTS ${BUILD}/python/quiver)  # the Python module, where Debian's python3 l
   endif()
 endif()
 
-# The CMake package, shared and static, from C and C++.
+# The CMake package, shared and static, from a C-only project and from a C and C++ one.
 foreach(variant shared static)
-  set(build ${BINARY}/consumer-${variant})
-  set(use_static OFF)
-  if(variant STREQUAL "static")
-    set(use_static ON)
-  endif()
-  run(${CMAKE_COMMAND} -S ${SOURCE}/tests/install/consumer -B ${build} -G Ninja -DCMAKE_PREFIX_PATH=${prefix}
-    -DQuiver_USE_STATIC_RUNTIME=${use_static} -DQUIVER_EXAMPLE=${SOURCE}/examples/embed/main.c)
-  run(${CMAKE_COMMAND} --build ${build})
-  run(${build}/consumer_c ${MODEL} 60)
-  if(NOT out MATCHES "after 60 frames")
-    message(FATAL_ERROR "the C consumer (${variant}) printed: ${out}")
-  endif()
-  run(${build}/consumer_cpp ${MODEL})
-  if(NOT out MATCHES "from C\\+\\+: r = ")
-    message(FATAL_ERROR "the C++ consumer (${variant}) printed: ${out}")
-  endif()
-  run(readelf -d ${build}/consumer_c)
-  if(variant STREQUAL "shared" AND NOT out MATCHES "libquiver_runtime\\.so\\.0\\.6")
-    message(FATAL_ERROR "the shared consumer does not load libquiver_runtime.so.0.6:\n${out}")
-  elseif(variant STREQUAL "static" AND out MATCHES "libquiver_runtime")
-    message(FATAL_ERROR "the static consumer loads the shared runtime:\n${out}")
-  endif()
-  message(STATUS "find_package(Quiver), ${variant}: C and C++ consumers ran")
+  foreach(languages c c-cpp)
+    set(build ${BINARY}/consumer-${variant}-${languages})
+    set(use_static OFF)
+    if(variant STREQUAL "static")
+      set(use_static ON)
+    endif()
+    set(c_only OFF)
+    if(languages STREQUAL "c")
+      set(c_only ON)
+    endif()
+    run(${CMAKE_COMMAND} -S ${SOURCE}/tests/install/consumer -B ${build} -G Ninja -DCMAKE_PREFIX_PATH=${prefix}
+      -DQuiver_USE_STATIC_RUNTIME=${use_static} -DC_ONLY=${c_only} -DQUIVER_EXAMPLE=${SOURCE}/examples/embed/main.c)
+    run(${CMAKE_COMMAND} --build ${build})
+    run(${build}/consumer_c ${MODEL} 60)
+    if(NOT out MATCHES "after 60 frames")
+      message(FATAL_ERROR "the C consumer (${variant}, ${languages}) printed: ${out}")
+    endif()
+    if(NOT c_only)
+      run(${build}/consumer_cpp ${MODEL})
+      if(NOT out MATCHES "from C\\+\\+: r = ")
+        message(FATAL_ERROR "the C++ consumer (${variant}) printed: ${out}")
+      endif()
+    endif()
+    run(readelf -d ${build}/consumer_c)
+    if(variant STREQUAL "shared" AND NOT out MATCHES "libquiver_runtime\\.so\\.${soversion}")
+      message(FATAL_ERROR "the shared consumer does not load libquiver_runtime.so.${soversion}:\n${out}")
+    elseif(variant STREQUAL "static" AND out MATCHES "libquiver_runtime")
+      message(FATAL_ERROR "the static consumer loads the shared runtime:\n${out}")
+    endif()
+    message(STATUS "find_package(Quiver), ${variant} runtime, ${languages} project: its programs ran")
+  endforeach()
 endforeach()
 
-# Another minor version is not compatible (0.x).
-file(WRITE ${BINARY}/old/CMakeLists.txt "cmake_minimum_required(VERSION 3.16)\nproject(old LANGUAGES C)\nfind_package(Quiver 0.5 REQUIRED)\n")
+# Another minor version is not compatible (0.x): a project asking for the previous one fails.
+string(REGEX MATCHALL "[0-9]+" parts ${QUIVER_VERSION})
+list(GET parts 0 major)
+list(GET parts 1 minor)
+math(EXPR previous "${minor} - 1")
+if(previous GREATER_EQUAL 0)
+file(WRITE ${BINARY}/old/CMakeLists.txt
+  "cmake_minimum_required(VERSION 3.18)\nproject(old LANGUAGES C)\nfind_package(Quiver ${major}.${previous} REQUIRED)\n")
 execute_process(COMMAND ${CMAKE_COMMAND} -S ${BINARY}/old -B ${BINARY}/old/build -DCMAKE_PREFIX_PATH=${prefix}
   RESULT_VARIABLE status OUTPUT_QUIET ERROR_QUIET)
 if(status EQUAL 0)
-  message(FATAL_ERROR "find_package(Quiver 0.5) accepted version 0.6")
+  message(FATAL_ERROR "find_package(Quiver ${major}.${previous}) accepted version ${QUIVER_VERSION}")
+endif()
 endif()
 
 # pkg-config, from a plain compiler command line.

@@ -109,6 +109,8 @@ def test_a_world_stacks_one_beam_on_another(free_model):
         world.add(low)
     with pytest.raises(ValueError, match="is in a World"):
         quiver.step_many([low])
+    with pytest.raises(ValueError, match="is in a World"):
+        low.step()
     with pytest.raises(ValueError, match="only flying instances"):
         world.add(quiver.Instance(free_model))
     with pytest.raises(ValueError, match="same time step"):
