@@ -1,6 +1,7 @@
 // quiver-bake: turns a tetrahedral mesh into a reduced model. Runs on one or many MPI ranks
 // (mpirun -n N quiver-bake ...); PETSc/SLEPc options (-eps_*, -st_*, -derivatives_*, -log_view)
 // pass through to the solvers.
+#include <cstdlib>
 #include <iostream>
 
 #include "apps/support/mesh_options.h"
@@ -90,6 +91,11 @@ int main(int argc, char** argv) {
   }
   for (int i = 0; i < argc; ++i) s.commandLine += (i ? " " : "") + std::string(argv[i]);
   for (size_t i = 1; i < petsc.size(); ++i) s.petscOptions += (i > 1 ? " " : "") + petsc[i];
+  // PETSc also reads options from the environment: they change results as much as the command line's.
+  if (const char* fromEnvironment = std::getenv("PETSC_OPTIONS"); fromEnvironment && *fromEnvironment) {
+    s.petscOptions += std::string(s.petscOptions.empty() ? "" : " ") + fromEnvironment;
+    s.commandLine = "PETSC_OPTIONS='" + std::string(fromEnvironment) + "' " + s.commandLine;
+  }
   s.mesh.path = meshOptions.path;
   s.mesh.checks = meshOptions.checks;
 
