@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <string>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
@@ -108,7 +109,7 @@ PetscKsp choleskySolver(Mat A) {
   return ksp;
 }
 
-// MPI_Alltoallv of doubles; the counts (per rank) must fit MPI's int, which rounds of a few columns do.
+// MPI_Alltoallv of doubles; the counts (per rank) must fit MPI's int, which solveColumns' rounds do.
 std::vector<double> exchange(const std::vector<double>& send, const std::vector<size_t>& sendCounts,
                              const std::vector<size_t>& receiveCounts, MPI_Comm comm) {
   const size_t size = sendCounts.size();
@@ -164,13 +165,19 @@ Eigen::MatrixXd solveColumns(Mat op, Eigen::MatrixXd B, const DofLayout& layout,
   QV_PETSC(MatGetOwnershipRanges(op, &ranges));
   auto rows = [&](int p) { return static_cast<Eigen::Index>(ranges[p + 1] - ranges[p]); };
   auto start = [&](int p) { return total * p / size; };  // rank p's columns: [start(p), start(p + 1))
-  Eigen::Index most = 0;
-  for (int p = 0; p < size; ++p) most = std::max(most, start(p + 1) - start(p));
+  Eigen::Index most = 0, widest = 0;
+  for (int p = 0; p < size; ++p) {
+    most = std::max(most, start(p + 1) - start(p));
+    widest = std::max(widest, rows(p));
+  }
   const Eigen::Index n = layout.globalDofs();
-  for (Eigen::Index first = 0; first < most; first += block) {
+  // Rounds small enough that every exchange's counts fit MPI's int (the same on every rank).
+  const Eigen::Index round =
+      std::max<Eigen::Index>(1, std::min<Eigen::Index>(block, INT_MAX / std::max(n, widest * size)));
+  for (Eigen::Index first = 0; first < most; first += round) {
     // This round: columns [begin(p), begin(p) + count(p)) of each rank p.
     auto begin = [&](int p) { return start(p) + first; };
-    auto count = [&](int p) { return std::clamp<Eigen::Index>(start(p + 1) - begin(p), 0, block); };
+    auto count = [&](int p) { return std::clamp<Eigen::Index>(start(p + 1) - begin(p), 0, round); };
     const Eigen::Index mine = count(rank);
     // Each rank's rows of my columns, in global row order.
     std::vector<double> send;
@@ -187,12 +194,24 @@ Eigen::MatrixXd solveColumns(Mat op, Eigen::MatrixXd B, const DofLayout& layout,
     Eigen::MatrixXd rhs(n, mine), x(n, mine);
     for (int p = 0, offset = 0; p < size; offset += static_cast<int>(receiveCounts[p]), ++p)
       rhs.middleRows(ranges[p], rows(p)) = Eigen::Map<const Eigen::MatrixXd>(received.data() + offset, rows(p), mine);
+    // A rank's own solve may fail alone (memory, MUMPS): every rank learns it before the next
+    // exchange, or the others would wait there for ever.
+    std::string failure;
     if (mine > 0) {
-      PetscMat b, solution;
-      QV_PETSC(MatCreateSeqDense(self, n, mine, rhs.data(), b.out()));
-      QV_PETSC(MatCreateSeqDense(self, n, mine, x.data(), solution.out()));
-      QV_PETSC(KSPMatSolve(ksp, b, solution));
+      try {
+        PetscMat b, solution;
+        QV_PETSC(MatCreateSeqDense(self, n, mine, rhs.data(), b.out()));
+        QV_PETSC(MatCreateSeqDense(self, n, mine, x.data(), solution.out()));
+        QV_PETSC(KSPMatSolve(ksp, b, solution));
+      } catch (const std::exception& e) {
+        failure = e.what();
+      }
     }
+    int failed = failure.empty() ? 0 : 1, anyFailed = 0;
+    MPI_Allreduce(&failed, &anyFailed, 1, MPI_INT, MPI_MAX, layout.comm());
+    if (anyFailed)
+      throw std::runtime_error("modal derivatives: " +
+                               (failure.empty() ? std::string("another rank's solve failed") : failure));
     // And back: each rank gets its rows of my columns.
     send.clear();
     for (int p = 0; p < size; ++p) {
@@ -207,7 +226,7 @@ Eigen::MatrixXd solveColumns(Mat op, Eigen::MatrixXd B, const DofLayout& layout,
         X.middleCols(begin(p), count(p)) = Eigen::Map<const Eigen::MatrixXd>(received.data() + offset, B.rows(), count(p));
     if (settings.progress) {
       Eigen::Index solved = 0;
-      for (int p = 0; p < size; ++p) solved += std::min(start(p + 1) - start(p), first + block);
+      for (int p = 0; p < size; ++p) solved += std::min(start(p + 1) - start(p), first + round);
       settings.progress(solved, total);
     }
   }

@@ -42,7 +42,7 @@ ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<
                                          const Eigen::MatrixXd& rigid, const DerivativeSettings& settings);
 
 // Checkpoint: group /derivatives. Input hash: the modes' and the stage's version tag (2: residuals
-// are normwise backward errors; 3: on several ranks, solved by a whole factor per rank).
+// are normwise backward errors; 3: on several ranks, a sequential factor per rank, issue #16).
 inline constexpr const char* kDerivativesVersion = "derivatives 3";
 std::string derivativesInputHash(const std::string& modesHash);
 void writeDerivatives(Archive& archive, const ModalDerivatives& derivatives, const DofLayout& layout,
