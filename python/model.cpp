@@ -72,6 +72,19 @@ const Model& modelOf(py::handle self) { return self.cast<const Model&>(); }
 
 py::tuple triple(const double (&v)[3]) { return py::make_tuple(v[0], v[1], v[2]); }
 
+using Info = const qv_model_info&;
+using Shape = std::vector<py::ssize_t>;
+
+// A property viewing one of the model's stored arrays (no copy; the view keeps the model alive),
+// its shape from the model's info.
+template <class T, class ShapeOf>
+py::cpp_function storedArray(const T* (*getter)(const qv_model*), ShapeOf shapeOf) {
+  return py::cpp_function([getter, shapeOf](py::object self) {
+    const Model& model = modelOf(self);
+    return view(self, getter(model.get()), py::dtype::of<T>(), shapeOf(model.info()));
+  });
+}
+
 } // namespace
 
 void bindModel(py::module_& m) {
@@ -111,7 +124,6 @@ void bindModel(py::module_& m) {
                ", has_rigid_body=" + (i.has_rigid_body ? "True" : "False") + ")";
       });
 
-  const auto f64 = py::dtype::of<double>(), f32 = py::dtype::of<float>(), u32 = py::dtype::of<unsigned>();
   py::class_<Model, std::shared_ptr<Model>>(m, "Model", R"(A baked model (.qvr), immutable; share it between any number of Instances.
 
 Model(path, coefficient_precision=64) loads a file; Model.from_bytes(data) an image in memory.
@@ -124,42 +136,32 @@ The stored arrays are read-only views of the model's memory (no copy); each keep
       .def_static("from_bytes", &loadBytes, py::arg("data"), py::arg("coefficient_precision") = 64,
                   "Loads a .qvr image from any bytes-like object (copied: the object may change afterwards).")
       .def_property_readonly("info", [](const Model& self) { return self.info(); }, "the model's ModelInfo")
-      .def_property_readonly("rest_positions", [f64](py::object self) {
-        const Model& model = modelOf(self);
-        return view(self, qv_model_rest_positions(model.get()), f64, {model.info().vertex_count, 3});
-      }, "(n, 3) float64: each vertex's rest position")
-      .def_property_readonly("triangles", [u32](py::object self) {
-        const Model& model = modelOf(self);
-        return view(self, qv_model_triangles(model.get()), u32, {model.info().triangle_count, 3});
-      }, "(t, 3) uint32: the surface triangles' vertex indices")
-      .def_property_readonly("vertex_map", [u32](py::object self) {
-        const Model& model = modelOf(self);
-        return view(self, qv_model_vertex_map(model.get()), u32, {model.info().vertex_count});
-      }, "(n,) uint32: each vertex's 0-based index in the mesh file it was baked from")
-      .def_property_readonly("eigenvalues", [f64](py::object self) {
-        const Model& model = modelOf(self);
-        return view(self, qv_model_eigenvalues(model.get()), f64, {model.info().eigenvalue_count});
-      }, "(e,) float64: the baked modes' eigenvalues, (rad/s)^2 in SI units")
-      .def_property_readonly("gravity", [f64](py::object self) {
-        const Model& model = modelOf(self);
-        return view(self, qv_model_gravity(model.get()), f64, {3, model.info().r});
-      }, "(3, r) float64: row a is U^T M e_a, the reduced force of a unit acceleration along axis a")
-      .def_property_readonly("render_rest_positions", [f32](py::object self) {
-        const Model& model = modelOf(self);
-        return view(self, qv_model_render_rest_positions(model.get()), f32, {model.info().render_vertex_count, 3});
-      }, "(V, 3) float32, or None without a render mesh")
-      .def_property_readonly("render_triangles", [u32](py::object self) {
-        const Model& model = modelOf(self);
-        return view(self, qv_model_render_triangles(model.get()), u32, {model.info().render_triangle_count, 3});
-      }, "(T, 3) uint32, counter-clockwise seen from outside, or None")
-      .def_property_readonly("render_normals", [f32](py::object self) {
-        const Model& model = modelOf(self);
-        return view(self, qv_model_render_normals(model.get()), f32, {model.info().render_vertex_count, 3});
-      }, "(V, 3) float32 rest normals, or None")
-      .def_property_readonly("render_uvs", [f32](py::object self) {
-        const Model& model = modelOf(self);
-        return view(self, qv_model_render_uvs(model.get()), f32, {model.info().render_vertex_count, 2});
-      }, "(V, 2) float32, or None when the render mesh has no UVs")
+      .def_property_readonly("rest_positions",
+                             storedArray(qv_model_rest_positions, [](Info i) { return Shape{i.vertex_count, 3}; }),
+                             "(n, 3) float64: each vertex's rest position")
+      .def_property_readonly("triangles",
+                             storedArray(qv_model_triangles, [](Info i) { return Shape{i.triangle_count, 3}; }),
+                             "(t, 3) uint32: the surface triangles' vertex indices")
+      .def_property_readonly("vertex_map",
+                             storedArray(qv_model_vertex_map, [](Info i) { return Shape{i.vertex_count}; }),
+                             "(n,) uint32: each vertex's 0-based index in the mesh file it was baked from")
+      .def_property_readonly("eigenvalues",
+                             storedArray(qv_model_eigenvalues, [](Info i) { return Shape{i.eigenvalue_count}; }),
+                             "(e,) float64: the baked modes' eigenvalues, (rad/s)^2 in SI units")
+      .def_property_readonly("gravity", storedArray(qv_model_gravity, [](Info i) { return Shape{3, i.r}; }),
+                             "(3, r) float64: row a is U^T M e_a, the reduced force of a unit acceleration along axis a")
+      .def_property_readonly("render_rest_positions",
+                             storedArray(qv_model_render_rest_positions, [](Info i) { return Shape{i.render_vertex_count, 3}; }),
+                             "(V, 3) float32, or None without a render mesh")
+      .def_property_readonly("render_triangles",
+                             storedArray(qv_model_render_triangles, [](Info i) { return Shape{i.render_triangle_count, 3}; }),
+                             "(T, 3) uint32, counter-clockwise seen from outside, or None")
+      .def_property_readonly("render_normals",
+                             storedArray(qv_model_render_normals, [](Info i) { return Shape{i.render_vertex_count, 3}; }),
+                             "(V, 3) float32 rest normals, or None")
+      .def_property_readonly("render_uvs",
+                             storedArray(qv_model_render_uvs, [](Info i) { return Shape{i.render_vertex_count, 2}; }),
+                             "(V, 2) float32, or None when the render mesh has no UVs")
       .def("evaluate", [](const Model& self, py::handle q) {
         const int r = self.info().r;
         const Doubles at = doubles(q, "q", {r});
