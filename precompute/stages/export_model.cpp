@@ -26,7 +26,9 @@ std::string exportModel(const BakeContext& ctx, const ExportRequest& request, co
   // Gravity projection U^T M e_a: the reduced force of a unit acceleration along each axis. M is
   // the whole mesh's consistent mass: a free vertex also carries weight it shares with its fixed
   // neighbours, which the assembled free-DOF matrix leaves out (2% of the sag on a 3-cell beam).
-  const Eigen::SparseMatrix<double> wholeMass = consistentMassMatrix(in.mesh.mesh, in.perTet);
+  // The rows of a consistent mass matrix sum to the lumped masses, so M e_a is the lumped M's
+  // (which assembles 12 entries a tet instead of 144).
+  const Eigen::SparseMatrix<double> wholeMass = lumpedMassMatrix(in.mesh.mesh, in.perTet);
   Eigen::MatrixXd axes = Eigen::MatrixXd::Zero(wholeMass.rows(), 3);
   for (Eigen::Index i = 0; i < axes.rows(); ++i) axes(i, i % 3) = 1;
   const Eigen::MatrixXd gravity = fullU.transpose() * (wholeMass * axes);
