@@ -1,5 +1,5 @@
 // quiver-bake: turns a tetrahedral mesh into a reduced model. Runs on one or many MPI ranks
-// (mpirun -n N quiver-bake ...); PETSc/SLEPc options (-eps_*, -st_*, -derivatives_*, -log_view)
+// (mpirun -n N quiver-bake ...); PETSc/SLEPc options (-factor_*, -eps_*, -st_*, -log_view)
 // pass through to the solvers.
 #include <cstdlib>
 #include <iostream>
@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
   CLI::App app{"quiver-bake: reduced St.Venant-Kirchhoff model of a tetrahedral mesh (Barbic & James 2005).\n"
                "Writes NAME.qvr (the runtime model; formats/model/QVR.md), NAME.h5 (every stage; formats/ARCHIVE.md)\n"
                "and NAME.xmf (ParaView).\n"
-               "PETSc/SLEPc options pass through: -eps_tol, -eps_ncv, -st_*, -derivatives_pc_*, -log_view, ..."};
+               "PETSc/SLEPc options pass through: -factor_* (the Cholesky factors), -eps_tol, -eps_ncv, -st_* (--eigensolver krylov-schur), -log_view, ..."};
   app::MeshOptions meshOptions;
   app::FixedVertexOptions fixedOptions;
   BakeSettings s;
@@ -46,6 +46,11 @@ int main(int argc, char** argv) {
   app.add_option("--density", s.mesh.material.density, "Density in kg/m^3 (> 0); overrides the mesh file's materials");
   app.add_option("--modes", s.modes, "Linear modes k (the six rigid modes of a free object are not counted)")
       ->capture_default_str();
+  app.add_option_function<std::string>(
+         "--eigensolver", [&](const std::string& name) { s.eigensolver = parseEigensolver(name); },
+         "How the modes are found: block (block Krylov-Schur, blocks of solves; default) or krylov-schur (SLEPc's, "
+         "one solve at a time; its -eps_* and -st_* options apply)")
+      ->check(CLI::IsMember({"block", "krylov-schur"}));
   app.add_option("--rank", s.basis.settings.rank, "Basis vectors r, at most the free DOFs; fewer (with a warning) where --basis yields fewer")
       ->capture_default_str();
   std::vector<std::string> kinds;

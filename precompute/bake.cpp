@@ -154,13 +154,16 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   stages.report("K and M of " + std::to_string(layout.globalDofs()) + " DOFs");
   const Eigen::MatrixXd rigid = in.freeObject() ? rigidModes(in.mesh.mesh, system.mass, layout) : Eigen::MatrixXd();
 
-  const std::string modesHash = modesInputHash(in.hash, s.modes, s.petscOptions);
-  const LinearModes modes = modesStage(stages, ctx, system, layout, rigid, s.modes, modesHash);
+  // K's factor, shared by the modes (at shift 0) and the derivatives of a fixed object.
+  StiffnessFactor stiffnessFactor(system.stiffness, layout);
+  const std::string modesHash = modesInputHash(in.hash, s.modes, s.eigensolver, s.petscOptions);
+  const LinearModes modes =
+      modesStage(stages, ctx, system, layout, rigid, s.modes, s.eigensolver, stiffnessFactor, modesHash);
   const bool derived = s.basis.userBasis.empty() && s.basis.settings.kind != BasisKind::Modes;
   const std::string derivativesHash = derivativesInputHash(modesHash);
   const ModalDerivatives derivatives =
       derived ? derivativesStage(stages, ctx, in.mesh.mesh, in.perTet, partition.tetPart, system, layout, modes, rigid,
-                                 derivativesHash)
+                                 stiffnessFactor, derivativesHash)
               : ModalDerivatives{};
   const std::string basisHash = s.basis.userBasis.empty()
                                     ? basisInputHash(derived ? derivativesHash : modesHash, s.basis.settings)

@@ -12,6 +12,7 @@
 #include "precompute/stages/export_model.h"
 #include "precompute/stages/fidelity.h"
 #include "precompute/stages/mesh.h"
+#include "precompute/stages/modes.h"
 #include "precompute/stages/surface.h"
 
 namespace quiver {
@@ -20,6 +21,7 @@ struct BakeSettings {
   MeshSettings mesh;           // the mesh, its checks, fixed vertices and materials (stages/mesh.h)
   SurfaceSettings surface;     // a surface input's tets, and the render mesh (stages/surface.h)
   int modes = 20;              // k, linear modes
+  Eigensolver eigensolver = Eigensolver::Block;  // how the modes are found (stages/modes.h)
   BasisRequest basis;          // r and the recipe, or a user basis (stages/basis.h)
   ExportRequest output;        // NAME, how NAME.qvr stores the model, the .npy exports (stages/export_model.h)
   FidelitySettings fidelity;   // the reduced model against full space at the end (stages/fidelity.h)

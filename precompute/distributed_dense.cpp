@@ -1,5 +1,7 @@
 #include "precompute/distributed_dense.h"
 
+#include <cblas.h>
+
 namespace quiver {
 
 PetscMat wrapDenseColumns(Eigen::MatrixXd& local, Eigen::Index first, Eigen::Index count, const DofLayout& layout) {
@@ -28,8 +30,22 @@ Eigen::MatrixXd multiply(Mat A, const Eigen::MatrixXd& X, const DofLayout& layou
   return out;
 }
 
-Eigen::MatrixXd innerProducts(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, MPI_Comm comm) {
-  Eigen::MatrixXd mine = X.transpose() * Y, total(mine.rows(), mine.cols());
+void multiplyInto(Eigen::Ref<const Eigen::MatrixXd> A, bool transposeA, Eigen::Ref<const Eigen::MatrixXd> B, double alpha,
+                  double beta, Eigen::Ref<Eigen::MatrixXd> C) {
+  const Eigen::Index inner = transposeA ? A.rows() : A.cols();
+  if (C.size() == 0) return;
+  if (inner == 0) {
+    C *= beta;
+    return;
+  }
+  cblas_dgemm(CblasColMajor, transposeA ? CblasTrans : CblasNoTrans, CblasNoTrans, static_cast<int>(C.rows()),
+              static_cast<int>(C.cols()), static_cast<int>(inner), alpha, A.data(), static_cast<int>(A.outerStride()),
+              B.data(), static_cast<int>(B.outerStride()), beta, C.data(), static_cast<int>(C.outerStride()));
+}
+
+Eigen::MatrixXd innerProducts(Eigen::Ref<const Eigen::MatrixXd> X, Eigen::Ref<const Eigen::MatrixXd> Y, MPI_Comm comm) {
+  Eigen::MatrixXd mine(X.cols(), Y.cols()), total(X.cols(), Y.cols());
+  multiplyInto(X, true, Y, 1.0, 0.0, mine);
   MPI_Allreduce(mine.data(), total.data(), static_cast<int>(mine.size()), MPI_DOUBLE, MPI_SUM, comm);
   return total;
 }

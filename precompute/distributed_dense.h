@@ -17,8 +17,13 @@ PetscMat wrapDenseColumns(Eigen::MatrixXd& local, Eigen::Index first, Eigen::Ind
 // This rank's rows of A X, for a distributed sparse A and row-distributed X. Collective.
 Eigen::MatrixXd multiply(Mat A, const Eigen::MatrixXd& X, const DofLayout& layout);
 
+// C = alpha op(A) B + beta C (op(A) = A or A^T) on this rank's data, through BLAS: the tall-skinny
+// products of the eigensolver and the projections run at OpenBLAS's speed, not portable Eigen's.
+void multiplyInto(Eigen::Ref<const Eigen::MatrixXd> A, bool transposeA, Eigen::Ref<const Eigen::MatrixXd> B, double alpha,
+                  double beta, Eigen::Ref<Eigen::MatrixXd> C);
+
 // X^T Y summed over all ranks: the same small matrix on every rank. Collective.
-Eigen::MatrixXd innerProducts(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, MPI_Comm comm);
+Eigen::MatrixXd innerProducts(Eigen::Ref<const Eigen::MatrixXd> X, Eigen::Ref<const Eigen::MatrixXd> Y, MPI_Comm comm);
 
 // Euclidean norm of each global column. Collective.
 Eigen::VectorXd columnNorms(const Eigen::MatrixXd& X, MPI_Comm comm);

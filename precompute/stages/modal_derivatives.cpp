@@ -1,15 +1,14 @@
 #include "precompute/stages/modal_derivatives.h"
 
 #include <algorithm>
-#include <climits>
 #include <string>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
-#include <petscksp.h>
 
 #include "common/stvk_element.h"
 #include "precompute/checkpoint.h"
+#include "precompute/direct_solver.h"
 #include "precompute/input_hash.h"
 #include "precompute/distributed_dense.h"
 
@@ -17,24 +16,42 @@ namespace quiver {
 
 namespace {
 
-using PetscKsp = PetscHandle<KSP, KSPDestroy>;
+Eigen::MatrixXd localBlock(Mat dense, const DofLayout& layout) {
+  PetscInt lda = 0, cols = 0;
+  const PetscScalar* values = nullptr;
+  QV_PETSC(MatGetSize(dense, nullptr, &cols));
+  QV_PETSC(MatDenseGetLDA(dense, &lda));
+  QV_PETSC(MatDenseGetArrayRead(dense, &values));
+  Eigen::MatrixXd out = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>(values, layout.localDofs(), cols,
+                                                                                  Eigen::OuterStride<>(lda));
+  QV_PETSC(MatDenseRestoreArrayRead(dense, &values));
+  return out;
+}
 
-// -d^2R[phi_i, phi_j] for every pair, as a distributed dense matrix (free DOFs x pairs).
-PetscMat rightHandSides(const TetMesh& mesh, const std::vector<Material>& perTet, const std::vector<int>& tetPart,
-                        const DofLayout& layout, const Eigen::MatrixXd& fullModes,
-                        const std::vector<std::array<int, 2>>& pairs) {
-  int rank = 0;
+// -d^2R[phi_i, phi_j] for every pair: this rank's rows (free DOFs x pairs). Each rank integrates its
+// own tets. Rows of its own DOFs add up in place, each DOF's pairs side by side (a tet adds 12
+// contiguous rows, not 12 x pairs scattered values); rows of DOFs another rank owns go there through
+// a distributed matrix (the partition's interface only).
+Eigen::MatrixXd rightHandSides(const TetMesh& mesh, const std::vector<Material>& perTet, const std::vector<int>& tetPart,
+                               const DofLayout& layout, const Eigen::MatrixXd& fullModes,
+                               const std::vector<std::array<int, 2>>& pairs) {
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  int rank = 0, size = 1;
   MPI_Comm_rank(layout.comm(), &rank);
+  MPI_Comm_size(layout.comm(), &size);
   const PetscInt P = static_cast<PetscInt>(pairs.size());
-  PetscMat B;
-  QV_PETSC(MatCreateDense(layout.comm(), layout.localDofs(), PETSC_DECIDE, layout.globalDofs(), P, nullptr, B.out()));
-  QV_PETSC(MatZeroEntries(B));
+  const int64_t first = layout.rowStart(), local = layout.localDofs();
+  RowMajor own = RowMajor::Zero(local, P);
+  PetscMat others;
+  if (size > 1) {
+    QV_PETSC(MatCreateDense(layout.comm(), local, PETSC_DECIDE, layout.globalDofs(), P, nullptr, others.out()));
+    QV_PETSC(MatZeroEntries(others));
+  }
   const TetElements elements = computeTetElements(mesh);
   std::vector<PetscInt> columns(P);
   for (PetscInt p = 0; p < P; ++p) columns[p] = p;
   std::vector<RestDirection> modeOnTet(fullModes.cols());
-  Eigen::Matrix<double, 12, Eigen::Dynamic, Eigen::RowMajor> values(12, P);
-  PetscInt dofs[12];
+  RowMajor values(12, P);
   for (int t = 0; t < mesh.tetCount(); ++t) {
     if (tetPart[t] != rank) continue;
     const Tet& tet = mesh.tets[t];
@@ -50,23 +67,23 @@ PetscMat rightHandSides(const TetMesh& mesh, const std::vector<Material>& perTet
       values.col(p) = -Eigen::Map<const Eigen::Matrix<double, 12, 1>>(f.data());
     }
     for (int a = 0; a < 4; ++a)
-      for (int c = 0; c < 3; ++c) dofs[3 * a + c] = static_cast<PetscInt>(layout.dof(tet[a], c));
-    QV_PETSC(MatSetValues(B, 12, dofs, P, columns.data(), values.data(), ADD_VALUES));
+      for (int c = 0; c < 3; ++c) {
+        const int64_t dof = layout.dof(tet[a], c);
+        if (dof < 0) continue;  // fixed
+        if (dof >= first && dof < first + local) {
+          own.row(dof - first) += values.row(3 * a + c);
+        } else {
+          const PetscInt row = static_cast<PetscInt>(dof);
+          QV_PETSC(MatSetValues(others, 1, &row, P, columns.data(), values.row(3 * a + c).data(), ADD_VALUES));
+        }
+      }
   }
-  QV_PETSC(MatAssemblyBegin(B, MAT_FINAL_ASSEMBLY));
-  QV_PETSC(MatAssemblyEnd(B, MAT_FINAL_ASSEMBLY));
-  return B;
-}
-
-Eigen::MatrixXd localBlock(Mat dense, const DofLayout& layout) {
-  PetscInt lda = 0, cols = 0;
-  const PetscScalar* values = nullptr;
-  QV_PETSC(MatGetSize(dense, nullptr, &cols));
-  QV_PETSC(MatDenseGetLDA(dense, &lda));
-  QV_PETSC(MatDenseGetArrayRead(dense, &values));
-  Eigen::MatrixXd out = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>(values, layout.localDofs(), cols,
-                                                                                  Eigen::OuterStride<>(lda));
-  QV_PETSC(MatDenseRestoreArrayRead(dense, &values));
+  Eigen::MatrixXd out = own;
+  if (size > 1) {
+    QV_PETSC(MatAssemblyBegin(others, MAT_FINAL_ASSEMBLY));
+    QV_PETSC(MatAssemblyEnd(others, MAT_FINAL_ASSEMBLY));
+    out += localBlock(others, layout);
+  }
   return out;
 }
 
@@ -94,158 +111,20 @@ std::vector<PetscInt> pinnedDofs(const TetMesh& mesh, const DofLayout& layout) {
   return dofs;
 }
 
-// A Cholesky solver of A (MUMPS; -derivatives_* options) on A's communicator.
-PetscKsp choleskySolver(Mat A) {
-  PetscKsp ksp;
-  PC pc;
-  QV_PETSC(KSPCreate(PetscObjectComm(reinterpret_cast<PetscObject>(A)), ksp.out()));
-  QV_PETSC(KSPSetOptionsPrefix(ksp, "derivatives_"));
-  QV_PETSC(KSPSetOperators(ksp, A, A));
-  QV_PETSC(KSPSetType(ksp, KSPPREONLY));
-  QV_PETSC(KSPGetPC(ksp, &pc));
-  QV_PETSC(PCSetType(pc, PCCHOLESKY));
-  QV_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
-  QV_PETSC(KSPSetFromOptions(ksp));
-  return ksp;
-}
-
-// MPI_Alltoallv of doubles; the counts (per rank) must fit MPI's int, which solveColumns' rounds do.
-std::vector<double> exchange(const std::vector<double>& send, const std::vector<size_t>& sendCounts,
-                             const std::vector<size_t>& receiveCounts, MPI_Comm comm) {
-  const size_t size = sendCounts.size();
-  std::vector<int> sc(size), so(size), rc(size), ro(size);
-  size_t sent = 0, received = 0;
-  for (size_t p = 0; p < size; ++p) {
-    if (sent + sendCounts[p] > INT_MAX || received + receiveCounts[p] > INT_MAX)
-      throw std::runtime_error("modal derivatives: a block of right-hand sides is too large for one MPI exchange");
-    so[p] = static_cast<int>(sent);
-    sc[p] = static_cast<int>(sendCounts[p]);
-    ro[p] = static_cast<int>(received);
-    rc[p] = static_cast<int>(receiveCounts[p]);
-    sent += sendCounts[p];
-    received += receiveCounts[p];
-  }
-  std::vector<double> receive(received);
-  MPI_Alltoallv(send.data(), sc.data(), so.data(), MPI_DOUBLE, receive.data(), rc.data(), ro.data(), MPI_DOUBLE, comm);
-  return receive;
-}
-
-// K X = B (B and X this rank's rows), in rounds of settings.blockSize right-hand sides.
-//
-// On one rank, one factorization of the distributed K. On several, parallel MUMPS would give bits
-// that change from run to run (it schedules its work as messages arrive), and SuperLU_DIST's
-// multi-right-hand-side solve corrupts its heap in Debian 12 (pdReDistribute_B_to_X). So every
-// rank factors the whole of K alone and solves its own share of the columns, whose bits depend on
-// the inputs and the rank count only (issue #16). The cost is a copy of K and its factor per rank;
-// -derivatives_distributed goes back to one distributed factorization (less memory per rank).
-Eigen::MatrixXd solveColumns(Mat op, Eigen::MatrixXd B, const DofLayout& layout, const DerivativeSettings& settings) {
-  int rank = 0, size = 1;
-  MPI_Comm_rank(layout.comm(), &rank);
-  MPI_Comm_size(layout.comm(), &size);
-  PetscBool distributed = PETSC_FALSE;
-  QV_PETSC(PetscOptionsGetBool(nullptr, "derivatives_", "-distributed", &distributed, nullptr));
-  const Eigen::Index total = B.cols(), block = settings.blockSize;
-  Eigen::MatrixXd X(B.rows(), total);
-  if (size == 1 || distributed) {
-    PetscKsp ksp = choleskySolver(op);
-    for (Eigen::Index first = 0; first < total; first += block) {
-      const Eigen::Index count = std::min(block, total - first);
-      PetscMat b = wrapDenseColumns(B, first, count, layout), x = wrapDenseColumns(X, first, count, layout);
-      QV_PETSC(KSPMatSolve(ksp, b, x));
-      if (settings.progress) settings.progress(first + count, total);
-    }
-    return X;
-  }
-
-  PetscMat whole;  // this rank's own copy of the whole matrix, on a communicator of one
-  QV_PETSC(MatCreateRedundantMatrix(op, size, MPI_COMM_NULL, MAT_INITIAL_MATRIX, whole.out()));
-  PetscKsp ksp = choleskySolver(whole);
-  const MPI_Comm self = PetscObjectComm(reinterpret_cast<PetscObject>(static_cast<Mat>(whole)));
-  const PetscInt* ranges = nullptr;  // rows follow PETSc's ownership ranges
-  QV_PETSC(MatGetOwnershipRanges(op, &ranges));
-  auto rows = [&](int p) { return static_cast<Eigen::Index>(ranges[p + 1] - ranges[p]); };
-  auto start = [&](int p) { return total * p / size; };  // rank p's columns: [start(p), start(p + 1))
-  Eigen::Index most = 0, widest = 0;
-  for (int p = 0; p < size; ++p) {
-    most = std::max(most, start(p + 1) - start(p));
-    widest = std::max(widest, rows(p));
-  }
-  const Eigen::Index n = layout.globalDofs();
-  // Rounds small enough that every exchange's counts fit MPI's int (the same on every rank).
-  const Eigen::Index round =
-      std::max<Eigen::Index>(1, std::min<Eigen::Index>(block, INT_MAX / std::max(n, widest * size)));
-  for (Eigen::Index first = 0; first < most; first += round) {
-    // This round: columns [begin(p), begin(p) + count(p)) of each rank p.
-    auto begin = [&](int p) { return start(p) + first; };
-    auto count = [&](int p) { return std::clamp<Eigen::Index>(start(p + 1) - begin(p), 0, round); };
-    const Eigen::Index mine = count(rank);
-    // Each rank's rows of my columns, in global row order.
-    std::vector<double> send;
-    std::vector<size_t> sendCounts(size), receiveCounts(size);
-    for (int p = 0; p < size; ++p) {
-      if (count(p) > 0) {  // columns of one rank are contiguous in B
-        const double* part = B.col(begin(p)).data();
-        send.insert(send.end(), part, part + B.rows() * count(p));
-      }
-      sendCounts[p] = static_cast<size_t>(B.rows() * count(p));
-      receiveCounts[p] = static_cast<size_t>(rows(p) * mine);
-    }
-    std::vector<double> received = exchange(send, sendCounts, receiveCounts, layout.comm());
-    Eigen::MatrixXd rhs(n, mine), x(n, mine);
-    for (int p = 0, offset = 0; p < size; offset += static_cast<int>(receiveCounts[p]), ++p)
-      rhs.middleRows(ranges[p], rows(p)) = Eigen::Map<const Eigen::MatrixXd>(received.data() + offset, rows(p), mine);
-    // A rank's own solve may fail alone (memory, MUMPS): every rank learns it before the next
-    // exchange, or the others would wait there for ever.
-    std::string failure;
-    if (mine > 0) {
-      try {
-        PetscMat b, solution;
-        QV_PETSC(MatCreateSeqDense(self, n, mine, rhs.data(), b.out()));
-        QV_PETSC(MatCreateSeqDense(self, n, mine, x.data(), solution.out()));
-        QV_PETSC(KSPMatSolve(ksp, b, solution));
-      } catch (const std::exception& e) {
-        failure = e.what();
-      }
-    }
-    int failed = failure.empty() ? 0 : 1, anyFailed = 0;
-    MPI_Allreduce(&failed, &anyFailed, 1, MPI_INT, MPI_MAX, layout.comm());
-    if (anyFailed)
-      throw std::runtime_error("modal derivatives: " +
-                               (failure.empty() ? std::string("another rank's solve failed") : failure));
-    // And back: each rank gets its rows of my columns.
-    send.clear();
-    for (int p = 0; p < size; ++p) {
-      const Eigen::MatrixXd part = x.middleRows(ranges[p], rows(p));
-      send.insert(send.end(), part.data(), part.data() + part.size());
-      sendCounts[p] = static_cast<size_t>(part.size());
-      receiveCounts[p] = static_cast<size_t>(B.rows() * count(p));
-    }
-    received = exchange(send, sendCounts, receiveCounts, layout.comm());
-    for (int p = 0, offset = 0; p < size; offset += static_cast<int>(receiveCounts[p]), ++p)
-      if (count(p) > 0)
-        X.middleCols(begin(p), count(p)) = Eigen::Map<const Eigen::MatrixXd>(received.data() + offset, B.rows(), count(p));
-    if (settings.progress) {
-      Eigen::Index solved = 0;
-      for (int p = 0; p < size; ++p) solved += std::min(start(p + 1) - start(p), first + round);
-      settings.progress(solved, total);
-    }
-  }
-  return X;
-}
-
 } // namespace
 
 ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<Material>& perTet,
                                          const std::vector<int>& tetPart, Mat stiffness, Mat mass,
                                          const DofLayout& layout, const LinearModes& modes,
-                                         const Eigen::MatrixXd& rigid, const DerivativeSettings& settings) {
+                                         const Eigen::MatrixXd& rigid, const DerivativeSettings& settings,
+                                         StiffnessFactor* sharedFactor) {
   ModalDerivatives out;
   const int k = static_cast<int>(modes.eigenvalues.size());
   for (int i = 0; i < k; ++i)
     for (int j = i; j < k; ++j) out.pairs.push_back({i, j});
 
-  PetscMat B = rightHandSides(mesh, perTet, tetPart, layout, layout.gatherToAll(modes.vectors), out.pairs);
-  Eigen::MatrixXd b = localBlock(B, layout);  // right-hand sides; projected below on free objects
+  // Right-hand sides; projected below on free objects.
+  Eigen::MatrixXd b = rightHandSides(mesh, perTet, tetPart, layout, layout.gatherToAll(modes.vectors), out.pairs);
   Eigen::MatrixXd solveFor;                    // what the (possibly pinned) system is solved for
   const bool freeObject = rigid.cols() > 0;
   PetscMat pinned;
@@ -265,7 +144,11 @@ ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<
     solveFor = b;
   }
 
-  out.vectors = solveColumns(op, std::move(solveFor), layout, settings);
+  // A fixed object's K may already be factored (the modes at shift 0); a free one's is pinned here.
+  std::unique_ptr<DirectSolver> own;
+  if (freeObject || !sharedFactor) own = std::make_unique<DirectSolver>(op, layout, "factor_");
+  const DirectSolver& solver = own ? *own : sharedFactor->get();
+  out.vectors = solver.solve(solveFor, settings.blockSize, settings.progress);
   if (freeObject) out.vectors -= rigid * innerProducts(rigid, multiply(mass, out.vectors, layout), layout.comm());
 
   // Normwise backward error against the unpinned system and the projected right-hand side,
@@ -322,7 +205,7 @@ std::string describeDerivatives(const ModalDerivatives& derivatives) {
 ModalDerivatives derivativesStage(StageRunner& stages, const BakeContext& ctx, const TetMesh& mesh,
                                   const std::vector<Material>& perTet, const std::vector<int>& tetPart,
                                   const AssembledSystem& system, const DofLayout& layout, const LinearModes& modes,
-                                  const Eigen::MatrixXd& rigid, const std::string& inputHash) {
+                                  const Eigen::MatrixXd& rigid, StiffnessFactor& factor, const std::string& inputHash) {
   bool reused = false;
   const ModalDerivatives derivatives = stages.checkpointed(
       "derivatives", "/derivatives", inputHash, [&](const Archive& a) { return readDerivatives(a, layout); },
@@ -331,7 +214,7 @@ ModalDerivatives derivativesStage(StageRunner& stages, const BakeContext& ctx, c
         DerivativeSettings settings;
         settings.progress = meter.callback();
         return computeModalDerivatives(mesh, perTet, tetPart, system.stiffness, system.mass, layout, modes, rigid,
-                                       settings);
+                                       settings, &factor);
       },
       [&](Archive& a, const ModalDerivatives& d, const std::string& h) { writeDerivatives(a, d, layout, h); }, reused);
   stages.report(describeDerivatives(derivatives), reused);

@@ -2,9 +2,8 @@
 // Stage "derivatives": modal derivatives K Psi_ij = -d^2R[phi_i, phi_j] for i <= j <= k (Barbič &
 // James 2005), the second derivative of the internal force at rest applied to two modes. Each rank
 // computes the right-hand sides of its tets exactly (stvkElementForceHessianAtRest); all k(k+1)/2
-// are solved in blocks with one Cholesky factorization of K (MUMPS; -derivatives_* options): the
-// distributed K on one rank; on several, each rank factors all of K and solves its share of the
-// right-hand sides, so that the bits do not change from run to run.
+// are solved in blocks with one Cholesky factorization of K (DirectSolver: the same bits every run),
+// the modes' own when they were computed at shift 0 in the same run.
 // On a free object K is singular: the right-hand sides are projected off the rigid modes, six
 // DOFs are pinned to pick one solution, and the result is made M-orthogonal to the rigid modes.
 #include <array>
@@ -16,6 +15,7 @@
 
 #include "common/tet_mesh.h"
 #include "precompute/archive/archive.h"
+#include "precompute/direct_solver.h"
 #include "precompute/dof_layout.h"
 #include "precompute/progress_meter.h"
 #include "precompute/stages/modes.h"
@@ -35,11 +35,12 @@ struct ModalDerivatives {
 };
 
 // Collective. `tetPart` says which tets this rank integrates; `rigid` is rigidModes() on a free
-// object and empty (0 columns) otherwise.
+// object and empty (0 columns) otherwise; a fixed object solves with `sharedFactor` when given.
 ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<Material>& perTet,
                                          const std::vector<int>& tetPart, Mat stiffness, Mat mass,
                                          const DofLayout& layout, const LinearModes& modes,
-                                         const Eigen::MatrixXd& rigid, const DerivativeSettings& settings);
+                                         const Eigen::MatrixXd& rigid, const DerivativeSettings& settings,
+                                         StiffnessFactor* sharedFactor = nullptr);
 
 // Checkpoint: group /derivatives. Input hash: the modes' and the stage's version tag (2: residuals
 // are normwise backward errors; 3: on several ranks, a sequential factor per rank, issue #16).
@@ -55,6 +56,6 @@ std::string describeDerivatives(const ModalDerivatives& derivatives);
 ModalDerivatives derivativesStage(StageRunner& stages, const BakeContext& ctx, const TetMesh& mesh,
                                   const std::vector<Material>& perTet, const std::vector<int>& tetPart,
                                   const AssembledSystem& system, const DofLayout& layout, const LinearModes& modes,
-                                  const Eigen::MatrixXd& rigid, const std::string& inputHash);
+                                  const Eigen::MatrixXd& rigid, StiffnessFactor& factor, const std::string& inputHash);
 
 } // namespace quiver

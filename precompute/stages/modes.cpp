@@ -8,6 +8,7 @@
 #include <dlfcn.h>
 #include <slepceps.h>
 
+#include "precompute/block_eigensolver.h"
 #include "precompute/checkpoint.h"
 #include "precompute/input_hash.h"
 #include "precompute/distributed_dense.h"
@@ -24,8 +25,6 @@ struct EigenPairs {
   Eigen::MatrixXd vectors;     // this rank's rows
 };
 
-// The `count` eigenpairs nearest `shift` by Krylov-Schur with shift-and-invert (a direct solver),
-// M-orthogonal to `deflation`'s columns. `fromOptions` lets -eps_* / -st_* override the defaults.
 struct MonitorContext {
   const ProgressCallback* progress;
   int wanted;
@@ -39,8 +38,10 @@ PetscErrorCode reportConverged(EPS, PetscInt, PetscInt converged, PetscScalar*, 
   return 0;
 }
 
-EigenPairs solveNearShift(Mat stiffness, Mat mass, const DofLayout& layout, double shift, int count, double tolerance,
-                          const Eigen::MatrixXd& deflation, bool fromOptions, const ProgressCallback& progress) {
+// The `count` eigenpairs nearest `shift` by SLEPc's Krylov-Schur with shift-and-invert (a direct
+// solver), M-orthogonal to `deflation`'s columns. `fromOptions` lets -eps_* / -st_* override the defaults.
+EigenPairs slepcKrylovSchur(Mat stiffness, Mat mass, const DofLayout& layout, double shift, int count, double tolerance,
+                            const Eigen::MatrixXd& deflation, bool fromOptions, const ProgressCallback& progress) {
   PetscEps eps;
   QV_PETSC(EPSCreate(layout.comm(), eps.out()));
   QV_PETSC(EPSSetOperators(eps, stiffness, mass));
@@ -134,6 +135,32 @@ EigenPairs solveNearShift(Mat stiffness, Mat mass, const DofLayout& layout, doub
   return out;
 }
 
+// The `count` eigenpairs nearest `shift` (below them all) by the block solver, with a factor of
+// K - shift M: K's shared one at shift 0.
+EigenPairs blockKrylovSchur(Mat stiffness, Mat mass, const DofLayout& layout, double shift, int count,
+                            double tolerance, const Eigen::MatrixXd& deflation, StiffnessFactor* sharedFactor,
+                            const ProgressCallback& progress) {
+  std::unique_ptr<DirectSolver> own;
+  PetscMat shifted;
+  if (shift != 0) {
+    QV_PETSC(MatDuplicate(stiffness, MAT_COPY_VALUES, shifted.out()));
+    QV_PETSC(MatAXPY(shifted, -shift, mass, UNKNOWN_NONZERO_PATTERN));
+    own = std::make_unique<DirectSolver>(shifted, layout, "factor_");
+  } else if (!sharedFactor) {
+    own = std::make_unique<DirectSolver>(stiffness, layout, "factor_");
+  }
+  const DirectSolver& solver = own ? *own : sharedFactor->get();
+  BlockEigenSettings settings;
+  settings.count = count;
+  settings.tolerance = tolerance;
+  settings.progress = progress;
+  PetscInt blockSize = 0;  // -modes_block_size: columns per block (default: block_eigensolver.h)
+  QV_PETSC(PetscOptionsGetInt(nullptr, nullptr, "-modes_block_size", &blockSize, nullptr));
+  settings.blockSize = static_cast<int>(blockSize);
+  BlockEigenPairs pairs = blockEigenpairs(solver, mass, shift, deflation, layout, settings);
+  return {std::move(pairs.values), std::move(pairs.vectors)};
+}
+
 // Largest diagonal ratio K_ii / M_ii: the scale of the pencil's eigenvalues.
 double diagonalRatio(Mat stiffness, Mat mass) {
   PetscVec k, m;
@@ -168,22 +195,27 @@ std::vector<double> eigenResiduals(Mat stiffness, Mat mass, const std::vector<do
 }
 
 LinearModes computeLinearModes(Mat stiffness, Mat mass, const DofLayout& layout, const ModeSettings& settings,
-                               const Eigen::MatrixXd& rigid) {
+                               const Eigen::MatrixXd& rigid, StiffnessFactor* sharedFactor) {
   const int64_t available = layout.globalDofs() - rigid.cols();
   if (settings.count > available)
     throw std::runtime_error("cannot compute " + std::to_string(settings.count) + " modes of a system with " +
                              std::to_string(available) + " elastic degrees of freedom");
+  // `wanted`: the solve that gives the modes (it reports progress; SLEPc's options apply to it).
+  auto solve = [&](double shift, int count, double tolerance, bool wanted) {
+    const ProgressCallback progress = wanted ? settings.progress : ProgressCallback();
+    return settings.solver == Eigensolver::Block
+               ? blockKrylovSchur(stiffness, mass, layout, shift, count, tolerance, rigid, sharedFactor, progress)
+               : slepcKrylovSchur(stiffness, mass, layout, shift, count, tolerance, rigid, wanted, progress);
+  };
   LinearModes out;
   out.rigidSkipped = static_cast<int>(rigid.cols());
   if (out.rigidSkipped > 0) {
     // K - sigma M is nearly singular for sigma just below 0: good enough to locate the first elastic
     // eigenvalue, not to compute modes accurately. Then solve again at half that value.
-    const double first = solveNearShift(stiffness, mass, layout, -1e-8 * diagonalRatio(stiffness, mass), 1, 1e-6,
-                                        rigid, false, ProgressCallback()).values[0];
+    const double first = solve(-1e-8 * diagonalRatio(stiffness, mass), 1, 1e-6, false).values[0];
     out.shift = -0.5 * first;
   }
-  EigenPairs pairs =
-      solveNearShift(stiffness, mass, layout, out.shift, settings.count, settings.tolerance, rigid, true, settings.progress);
+  EigenPairs pairs = solve(out.shift, settings.count, settings.tolerance, true);
   out.eigenvalues = std::move(pairs.values);
   out.vectors = std::move(pairs.vectors);
   // SLEPc returns M-normalised vectors for GHEP; normalise again so the contract does not rest on it.
@@ -225,8 +257,18 @@ LinearModes readModes(const Archive& archive, const DofLayout& layout) {
   return modes;
 }
 
-std::string modesInputHash(const std::string& meshHash, int count, const std::string& petscOptions) {
-  return InputHash().add(meshHash).add(count).add(petscOptions).add(kModesVersion).hex();
+Eigensolver parseEigensolver(const std::string& name) {
+  if (name == "block") return Eigensolver::Block;
+  if (name == "krylov-schur") return Eigensolver::KrylovSchur;
+  throw std::invalid_argument("--eigensolver " + name + ": expected block or krylov-schur");
+}
+
+const char* eigensolverName(Eigensolver solver) {
+  return solver == Eigensolver::Block ? "block" : "krylov-schur";
+}
+
+std::string modesInputHash(const std::string& meshHash, int count, Eigensolver solver, const std::string& petscOptions) {
+  return InputHash().add(meshHash).add(count).add(eigensolverName(solver)).add(petscOptions).add(kModesVersion).hex();
 }
 
 std::vector<std::string> describeModes(const LinearModes& modes) {
@@ -241,7 +283,8 @@ std::vector<std::string> describeModes(const LinearModes& modes) {
 }
 
 LinearModes modesStage(StageRunner& stages, const BakeContext& ctx, const AssembledSystem& system,
-                       const DofLayout& layout, const Eigen::MatrixXd& rigid, int count, const std::string& inputHash) {
+                       const DofLayout& layout, const Eigen::MatrixXd& rigid, int count, Eigensolver solver,
+                       StiffnessFactor& factor, const std::string& inputHash) {
   bool reused = false;
   const LinearModes modes = stages.checkpointed(
       "modes", "/modes", inputHash, [&](const Archive& a) { return readModes(a, layout); },
@@ -249,8 +292,9 @@ LinearModes modesStage(StageRunner& stages, const BakeContext& ctx, const Assemb
         ProgressMeter meter(ctx, "modes", "converged");
         ModeSettings settings;
         settings.count = count;
+        settings.solver = solver;
         settings.progress = meter.callback();
-        return computeLinearModes(system.stiffness, system.mass, layout, settings, rigid);
+        return computeLinearModes(system.stiffness, system.mass, layout, settings, rigid, &factor);
       },
       [&](Archive& a, const LinearModes& m, const std::string& h) { writeModes(a, m, layout, h); }, reused);
   const std::vector<std::string> lines = describeModes(modes);

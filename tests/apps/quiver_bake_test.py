@@ -149,13 +149,17 @@ class QuiverBake(unittest.TestCase):
             self.assertIn("slower kernels than this CPU can run", p.stdout)
 
     def test_petsc_options_pass_through(self):
-        p = bake(1, self.beam, "--fix", "x<min+1e-9", "--modes", "2", "--rank", "3", "-o",
-                 os.path.join(self.dir, "opts"), "-log_view", ":" + os.path.join(self.dir, "log.txt"), "-eps_tol", "1e-13")
-        self.assertEqual(p.returncode, 0, p.stderr)
-        with open(os.path.join(self.dir, "log.txt")) as log:
-            self.assertIn("EPSSolve", log.read())
-        self.assertNotIn("was not used", p.stderr)
-        self.assertIn("defines no material; using E = 1e+06 Pa, nu = 0.45, density = 1000", p.stderr)
+        # SLEPc's options reach its Krylov-Schur; the factor the default block solver uses takes -factor_*.
+        for solver, options, event in (("krylov-schur", ["-eps_tol", "1e-13"], "EPSSolve"),
+                                       ("block", ["-factor_mat_mumps_icntl_14", "40"], "BlkEigOrthog")):
+            p = bake(1, self.beam, "--fix", "x<min+1e-9", "--modes", "2", "--rank", "3", "-o",
+                     os.path.join(self.dir, "opts"), "--eigensolver", solver,
+                     "-log_view", ":" + os.path.join(self.dir, "log.txt"), *options)
+            self.assertEqual(p.returncode, 0, p.stderr)
+            with open(os.path.join(self.dir, "log.txt")) as log:
+                self.assertIn(event, log.read())
+            self.assertNotIn("was not used", p.stderr)
+            self.assertIn("defines no material; using E = 1e+06 Pa, nu = 0.45, density = 1000", p.stderr)
         p = bake(1, self.beam, "--fix", "x<min+1e-9", "--modes", "2", "--rank", "3", "-o",
                  os.path.join(self.dir, "opts"), "-eps_tl", "1e-13")
         self.assertEqual(p.returncode, 0, p.stderr)

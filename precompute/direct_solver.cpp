@@ -1,0 +1,155 @@
+#include "precompute/direct_solver.h"
+
+#include <algorithm>
+#include <climits>
+#include <stdexcept>
+
+#include "precompute/distributed_dense.h"
+
+namespace quiver {
+
+namespace {
+
+// MPI_Alltoallv of doubles; the counts (per rank) must fit MPI's int, which solve()'s rounds do.
+std::vector<double> exchange(const std::vector<double>& send, const std::vector<size_t>& sendCounts,
+                             const std::vector<size_t>& receiveCounts, MPI_Comm comm) {
+  const size_t size = sendCounts.size();
+  std::vector<int> sc(size), so(size), rc(size), ro(size);
+  size_t sent = 0, received = 0;
+  for (size_t p = 0; p < size; ++p) {
+    if (sent + sendCounts[p] > INT_MAX || received + receiveCounts[p] > INT_MAX)
+      throw std::runtime_error("direct solver: a block of right-hand sides is too large for one MPI exchange");
+    so[p] = static_cast<int>(sent);
+    sc[p] = static_cast<int>(sendCounts[p]);
+    ro[p] = static_cast<int>(received);
+    rc[p] = static_cast<int>(receiveCounts[p]);
+    sent += sendCounts[p];
+    received += receiveCounts[p];
+  }
+  std::vector<double> receive(received);
+  MPI_Alltoallv(send.data(), sc.data(), so.data(), MPI_DOUBLE, receive.data(), rc.data(), ro.data(), MPI_DOUBLE, comm);
+  return receive;
+}
+
+// Every rank learns whether any rank failed, so that none waits for ever in the next exchange.
+void agreeOnFailure(const std::string& failure, MPI_Comm comm) {
+  int failed = failure.empty() ? 0 : 1, anyFailed = 0;
+  MPI_Allreduce(&failed, &anyFailed, 1, MPI_INT, MPI_MAX, comm);
+  if (anyFailed) throw std::runtime_error(failure.empty() ? std::string("another rank's factorization or solve failed") : failure);
+}
+
+} // namespace
+
+DirectSolver::DirectSolver(Mat A, const DofLayout& layout, const std::string& optionsPrefix) : layout_(layout) {
+  int size = 1;
+  MPI_Comm_size(layout.comm(), &size);
+  PetscBool distributed = PETSC_FALSE;
+  QV_PETSC(PetscOptionsGetBool(nullptr, optionsPrefix.c_str(), "-distributed", &distributed, nullptr));
+  redundant_ = size > 1 && !distributed;
+  const PetscInt* ranges = nullptr;
+  QV_PETSC(MatGetOwnershipRanges(A, &ranges));
+  ranges_.assign(ranges, ranges + size + 1);
+  if (redundant_) QV_PETSC(MatCreateRedundantMatrix(A, size, MPI_COMM_NULL, MAT_INITIAL_MATRIX, whole_.out()));
+  Mat op = redundant_ ? whole_.get() : A;
+  std::string failure;
+  try {
+    PC pc;
+    QV_PETSC(KSPCreate(PetscObjectComm(reinterpret_cast<PetscObject>(op)), ksp_.out()));
+    QV_PETSC(KSPSetOptionsPrefix(ksp_, optionsPrefix.c_str()));
+    QV_PETSC(KSPSetOperators(ksp_, op, op));
+    QV_PETSC(KSPSetType(ksp_, KSPPREONLY));
+    QV_PETSC(KSPGetPC(ksp_, &pc));
+    QV_PETSC(PCSetType(pc, PCCHOLESKY));
+    QV_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+    QV_PETSC(KSPSetFromOptions(ksp_));
+    QV_PETSC(KSPSetUp(ksp_));
+  } catch (const std::exception& e) {
+    if (!redundant_) throw;  // collective calls: every rank throws alike
+    failure = e.what();
+  }
+  if (redundant_) agreeOnFailure(failure, layout.comm());
+}
+
+Eigen::MatrixXd DirectSolver::solve(const Eigen::MatrixXd& B, Eigen::Index round,
+                                    const ProgressCallback& progress) const {
+  const Eigen::Index total = B.cols();
+  Eigen::MatrixXd X(B.rows(), total);
+  if (!redundant_) {
+    Eigen::MatrixXd b = B;  // PETSc wants writable arrays
+    for (Eigen::Index first = 0; first < total; first += round) {
+      const Eigen::Index count = std::min(round, total - first);
+      PetscMat rhs = wrapDenseColumns(b, first, count, layout_), x = wrapDenseColumns(X, first, count, layout_);
+      QV_PETSC(KSPMatSolve(ksp_, rhs, x));
+      if (progress) progress(first + count, total);
+    }
+    return X;
+  }
+
+  int rank = 0, size = 1;
+  MPI_Comm_rank(layout_.comm(), &rank);
+  MPI_Comm_size(layout_.comm(), &size);
+  const MPI_Comm self = PetscObjectComm(reinterpret_cast<PetscObject>(whole_.get()));
+  auto rows = [&](int p) { return static_cast<Eigen::Index>(ranges_[p + 1] - ranges_[p]); };
+  auto start = [&](int p) { return total * p / size; };  // rank p's columns: [start(p), start(p + 1))
+  Eigen::Index most = 0, widest = 0;
+  for (int p = 0; p < size; ++p) {
+    most = std::max(most, start(p + 1) - start(p));
+    widest = std::max(widest, rows(p));
+  }
+  const Eigen::Index n = layout_.globalDofs();
+  // Rounds small enough that every exchange's counts fit MPI's int (the same on every rank).
+  round = std::max<Eigen::Index>(1, std::min<Eigen::Index>(round, INT_MAX / std::max(n, widest * size)));
+  for (Eigen::Index first = 0; first < most; first += round) {
+    // This round: columns [begin(p), begin(p) + count(p)) of each rank p.
+    auto begin = [&](int p) { return start(p) + first; };
+    auto count = [&](int p) { return std::clamp<Eigen::Index>(start(p + 1) - begin(p), 0, round); };
+    const Eigen::Index mine = count(rank);
+    // Each rank's rows of my columns, in global row order.
+    std::vector<double> send;
+    std::vector<size_t> sendCounts(size), receiveCounts(size);
+    for (int p = 0; p < size; ++p) {
+      if (count(p) > 0) {  // columns of one rank are contiguous in B
+        const double* part = B.col(begin(p)).data();
+        send.insert(send.end(), part, part + B.rows() * count(p));
+      }
+      sendCounts[p] = static_cast<size_t>(B.rows() * count(p));
+      receiveCounts[p] = static_cast<size_t>(rows(p) * mine);
+    }
+    std::vector<double> received = exchange(send, sendCounts, receiveCounts, layout_.comm());
+    Eigen::MatrixXd rhs(n, mine), x(n, mine);
+    for (int p = 0, offset = 0; p < size; offset += static_cast<int>(receiveCounts[p]), ++p)
+      rhs.middleRows(ranges_[p], rows(p)) = Eigen::Map<const Eigen::MatrixXd>(received.data() + offset, rows(p), mine);
+    std::string failure;
+    if (mine > 0) {
+      try {
+        PetscMat b, solution;
+        QV_PETSC(MatCreateSeqDense(self, n, mine, rhs.data(), b.out()));
+        QV_PETSC(MatCreateSeqDense(self, n, mine, x.data(), solution.out()));
+        QV_PETSC(KSPMatSolve(ksp_, b, solution));
+      } catch (const std::exception& e) {
+        failure = e.what();
+      }
+    }
+    agreeOnFailure(failure, layout_.comm());
+    // And back: each rank gets its rows of my columns.
+    send.clear();
+    for (int p = 0; p < size; ++p) {
+      const Eigen::MatrixXd part = x.middleRows(ranges_[p], rows(p));
+      send.insert(send.end(), part.data(), part.data() + part.size());
+      sendCounts[p] = static_cast<size_t>(part.size());
+      receiveCounts[p] = static_cast<size_t>(B.rows() * count(p));
+    }
+    received = exchange(send, sendCounts, receiveCounts, layout_.comm());
+    for (int p = 0, offset = 0; p < size; offset += static_cast<int>(receiveCounts[p]), ++p)
+      if (count(p) > 0)
+        X.middleCols(begin(p), count(p)) = Eigen::Map<const Eigen::MatrixXd>(received.data() + offset, B.rows(), count(p));
+    if (progress) {
+      Eigen::Index solved = 0;
+      for (int p = 0; p < size; ++p) solved += std::min(start(p + 1) - start(p), first + round);
+      progress(solved, total);
+    }
+  }
+  return X;
+}
+
+} // namespace quiver

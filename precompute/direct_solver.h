@@ -1,0 +1,60 @@
+#pragma once
+// A Cholesky factorization (MUMPS) of a distributed symmetric positive definite matrix that solves
+// blocks of right-hand sides with the same bits every run (issue #16). On one rank it factors the
+// distributed matrix. On several, parallel MUMPS would give bits that change from run to run (it
+// schedules its work as messages arrive) and SuperLU_DIST's multi-right-hand-side solve corrupts its
+// heap in Debian 12 (pdReDistribute_B_to_X); so each rank factors the whole matrix alone and solves
+// its own share of the columns, whose bits depend on the inputs and the rank count only. That costs
+// a copy of the matrix and its factor per rank; -<prefix>distributed goes back to one distributed
+// factorization (less memory per rank, bits that may change). Options: -<prefix>pc_*, -<prefix>ksp_*.
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <petscksp.h>
+
+#include "precompute/dof_layout.h"
+#include "precompute/petsc_handle.h"
+#include "precompute/progress_meter.h"
+#include "precompute/stages/assemble.h"
+
+namespace quiver {
+
+class DirectSolver {
+public:
+  // Factors A now (collective); A must outlive the solver. Throws std::runtime_error when it fails.
+  DirectSolver(Mat A, const DofLayout& layout, const std::string& optionsPrefix);
+
+  // X with A X = B (this rank's rows of both), at most `round` columns per factor solve, progress
+  // after each round. Collective; a failure on any rank throws on every rank.
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& B, Eigen::Index round = 32,
+                        const ProgressCallback& progress = ProgressCallback()) const;
+
+private:
+  using PetscKsp = PetscHandle<KSP, KSPDestroy>;
+  const DofLayout& layout_;
+  PetscMat whole_;  // several ranks: this rank's copy of the whole matrix, on a communicator of one
+  PetscKsp ksp_;
+  bool redundant_ = false;
+  std::vector<PetscInt> ranges_;  // rows of each rank (PETSc's ownership ranges)
+};
+
+// K's factor, made by the first stage that asks for it and kept for the next: the modes of a fixed
+// object (shift 0) and its modal derivatives solve with the same K.
+class StiffnessFactor {
+public:
+  StiffnessFactor(Mat stiffness, const DofLayout& layout) : stiffness_(stiffness), layout_(layout) {}
+  const DirectSolver& get() {
+    if (!solver_) solver_ = std::make_unique<DirectSolver>(stiffness_, layout_, "factor_");
+    return *solver_;
+  }
+
+private:
+  Mat stiffness_;
+  const DofLayout& layout_;
+  std::unique_ptr<DirectSolver> solver_;
+};
+
+} // namespace quiver
