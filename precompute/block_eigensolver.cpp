@@ -108,11 +108,13 @@ BlockEigenPairs blockEigenpairs(const DirectSolver& shiftedInverse, Mat mass, do
   if (k < 1 || k >= room)
     throw std::invalid_argument("cannot compute " + std::to_string(k) + " eigenpairs in a space of " +
                                 std::to_string(room) + " dimensions");
-  const int b = settings.blockSize > 0 ? settings.blockSize : std::min(std::max(k, 4), 24);
+  // Blocks of 16 at k = 20 on the torus of bench/torus_bake.py: modes in 4.9 s on one rank (12: 5.0,
+  // 20: 5.4, 24: 5.7; larger blocks amortise the factor better but orthogonalise more).
+  const int b = settings.blockSize > 0 ? settings.blockSize : std::min(std::max(k, 4), 16);
   // The basis grows to `cap` columns, then restarts from its best k + b Ritz vectors; then Z (at
   // most b columns, M-orthogonal to the basis it came from) always fits beside what is kept. On the
-  // torus of bench/torus_bake.py (k = b = 20) 4 blocks beyond k took 360 solves, 7 blocks 340 at
-  // nearly twice the orthogonalisation, 2 blocks 360 with more restarts.
+  // torus (k = b = 20) 4 blocks beyond k took 360 solves, 7 blocks 340 at nearly twice the
+  // orthogonalisation, 2 blocks 360 with more restarts.
   const Eigen::Index cap = static_cast<Eigen::Index>(std::min<int64_t>(room, k + 4 * b));
   const int64_t maxColumns = 200 * static_cast<int64_t>(k + b);
   const Eigen::Index n = layout.localDofs();

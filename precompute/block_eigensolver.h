@@ -23,7 +23,7 @@ namespace quiver {
 struct BlockEigenSettings {
   int count = 20;            // eigenpairs wanted
   double tolerance = 1e-12;  // ||(K - sigma M)^-1 M x - theta x||_M / theta_1, x M-normalised, theta = 1 / (lambda - sigma)
-  int blockSize = 0;         // 0: min(max(count, 4), 24)
+  int blockSize = 0;         // 0: min(max(count, 4), 16); -modes_block_size in the bake
   ProgressCallback progress; // (converged, count)
 };
 
