@@ -165,6 +165,7 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
       derived ? derivativesStage(stages, ctx, in.mesh.mesh, in.perTet, partition.tetPart, system, layout, modes, rigid,
                                  stiffnessFactor, derivativesHash)
               : ModalDerivatives{};
+  stiffnessFactor.release();  // a copy of K and its factor per rank: not kept through the later stages
   const std::string basisHash = s.basis.userBasis.empty()
                                     ? basisInputHash(derived ? derivativesHash : modesHash, s.basis.settings)
                                     : userBasisInputHash(in.hash, s.basis.userBasis);

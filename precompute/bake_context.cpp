@@ -74,13 +74,20 @@ void BakeContext::onRankZero(const std::function<void()>& work) const {
 }
 
 std::string BakeContext::agreeOnError(const std::string& localError) const {
-  int mine = localError.empty() ? size_ : rank_, first = size_;
-  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm());
-  if (first == size_) return "";
+  return firstRankError(localError, comm());
+}
+
+std::string firstRankError(const std::string& localError, MPI_Comm comm) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  int mine = localError.empty() ? size : rank, first = size;
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm);
+  if (first == size) return "";
   int length = static_cast<int>(localError.size());
-  MPI_Bcast(&length, 1, MPI_INT, first, comm());
-  std::string message = rank_ == first ? localError : std::string(length, ' ');
-  MPI_Bcast(message.data(), length, MPI_CHAR, first, comm());
+  MPI_Bcast(&length, 1, MPI_INT, first, comm);
+  std::string message = rank == first ? localError : std::string(length, ' ');
+  MPI_Bcast(message.data(), length, MPI_CHAR, first, comm);
   return first > 0 ? message + " (rank " + std::to_string(first) + ")" : message;
 }
 

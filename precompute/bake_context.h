@@ -42,6 +42,9 @@ private:
   int rank_ = 0, size_ = 1;
 };
 
+// The same on any communicator: the lowest failing rank's error, tagged with its rank, on every rank.
+std::string firstRankError(const std::string& localError, MPI_Comm comm);
+
 // Splits a command line into the tool's own options and PETSc's. PETSc options are single-dash
 // options with names longer than one letter (-eps_type krylovschur, -log_view), each followed by
 // its value when the next word is not itself an option. Both lists start with argv[0].

@@ -16,8 +16,8 @@ namespace {
 
 using Eigen::MatrixXd;
 
-// Uniform in [-0.5, 0.5), from (global row, column, seed) alone (splitmix64): the same start every
-// run, whatever the rows each rank holds.
+// Uniform in [-0.5, 0.5), from (vertex, component, column, seed) alone (splitmix64): the same start
+// every run and on any rank count (PETSc's row numbering follows the partition; vertices do not).
 double startEntry(uint64_t row, uint64_t column, uint64_t seed) {
   uint64_t z = row * 0x9E3779B97F4A7C15ull + column * 0xBF58476D1CE4E5B9ull + seed * 0x94D049BB133111EBull;
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
@@ -51,23 +51,25 @@ struct Orthonormalizer {
     MatrixXd coefficients = MatrixXd::Zero(V.cols(), Z.cols());
     if (projectedGram) projectedGram->resize(0, 0);
     if (Z.cols() == 0) MZ.resize(Z.rows(), 0);
+    bool freshProduct = true;  // pass 0 forms M Z; pass 1 again if pass 0 scaled up tiny directions
     for (int pass = 0; pass < 2 && Z.cols() > 0; ++pass) {
       if (deflation.cols() > 0) {
         const MatrixXd d = innerProducts(massDeflation, Z, comm);
         multiplyInto(deflation, false, d, -1.0, 1.0, Z);
-        if (pass > 0) multiplyInto(massDeflation, false, d, -1.0, 1.0, MZ);
+        if (!freshProduct) multiplyInto(massDeflation, false, d, -1.0, 1.0, MZ);
       }
       MatrixXd c = MatrixXd::Zero(V.cols(), Z.cols());
       if (V.cols() > 0) {
         c = innerProducts(MV, Z, comm);
         multiplyInto(V, false, c, -1.0, 1.0, Z);
-        if (pass > 0) multiplyInto(MV, false, c, -1.0, 1.0, MZ);
+        if (!freshProduct) multiplyInto(MV, false, c, -1.0, 1.0, MZ);
       }
-      if (pass == 0) MZ = multiply(mass, Z, layout);
+      if (freshProduct) MZ = multiply(mass, Z, layout);
       MatrixXd gram = innerProducts(Z, MZ, comm);
       gram = 0.5 * (gram + gram.transpose());
       // The block's squared norms as it came in: projected away plus what is left (V is M-orthonormal).
-      const double scale = pass == 0 ? (c.colwise().squaredNorm().transpose() + gram.diagonal()).maxCoeff() : 1.0;
+      const double scale = pass == 0 ? (c.colwise().squaredNorm().transpose() + gram.diagonal()).maxCoeff()
+                                     : gram.diagonal().maxCoeff();
       if (pass == 0) {
         coefficients = c;
         if (projectedGram) *projectedGram = gram;
@@ -82,6 +84,9 @@ struct Orthonormalizer {
         S.col(j) = e.eigenvectors().col(kept[j]) / std::sqrt(e.eigenvalues()[kept[j]]);
       Z = product(Z, S);
       MZ = product(MZ, S);
+      // Directions scaled up from below 1e-8 of the largest carry M Z's rounding amplified past what
+      // the update of pass 1 may keep (the same decision on every rank: the Gram matrix is global).
+      freshProduct = !kept.empty() && e.eigenvalues()[kept.back()] < 1e-16 * e.eigenvalues()[kept.front()];
     }
     return coefficients;
   }
@@ -134,7 +139,8 @@ BlockEigenPairs blockEigenpairs(const DirectSolver& shiftedInverse, Mat mass, do
   auto randomBlock = [&](MatrixXd& Z, MatrixXd& MZ) {
     Z.resize(n, b);
     for (Eigen::Index j = 0; j < b; ++j)
-      for (Eigen::Index i = 0; i < n; ++i) Z(i, j) = startEntry(static_cast<uint64_t>(layout.rowStart() + i), j, seed);
+      for (Eigen::Index i = 0; i < n; ++i)
+        Z(i, j) = startEntry(3 * static_cast<uint64_t>(layout.ownedVertices()[i / 3]) + i % 3, j, seed);
     ++seed;
     orthonormalize(V.leftCols(m), MV.leftCols(m), Z, MZ, nullptr);
   };

@@ -2,9 +2,9 @@
 // The eigenpairs of K x = lambda M x nearest a shift sigma below them, by a block Krylov-Schur
 // iteration with shift-and-invert: Rayleigh-Ritz on a block Krylov space of (K - sigma M)^-1 M,
 // M-orthonormal, thick restarts keeping the best Ritz vectors. It exists for one reason: blocks.
-// A triangular solve with one right-hand side streams the whole factor for little arithmetic; one
-// with twenty costs little more (on a 97k-tet torus: 51 ms for one, about 7 ms per column for
-// twenty), and SLEPc's Krylov-Schur solves one vector at a time. SLEPc's LOBPCG, which calls the
+// A triangular solve with one right-hand side streams the whole factor for little arithmetic; in
+// blocks each column costs far less (on a 97k-tet torus: 51 ms for one, about 7 ms a column in
+// blocks of twenty), and SLEPc's Krylov-Schur solves one vector at a time. SLEPc's LOBPCG, which calls the
 // blocked solve, broke down in its Gram matrix (DSSolve_GHEP) on that torus; Trilinos' Anasazi
 // BlockKrylovSchur (Debian has it) needed 260-1200 solves there and an M product per
 // orthogonalisation, no faster than SLEPc. SLEPc's Krylov-Schur stays available
@@ -33,9 +33,10 @@ struct BlockEigenPairs {
   int solvedColumns = 0;       // right-hand sides solved
 };
 
-// `shiftedInverse` solves with K - shift M, which must be positive definite on the M-orthogonal
-// complement of `deflation` (this rank's rows of M-orthonormal columns, e.g. the rigid modes, or
-// none). The starting block is pseudo-random by global row: the same bits every run. Collective.
+// `shiftedInverse` solves with K - shift M, which must be positive definite (it is a Cholesky
+// factor); the iteration stays M-orthogonal to `deflation` (this rank's rows of M-orthonormal
+// columns, e.g. the rigid modes, or none). The starting block is pseudo-random by vertex: the same bits every run, the same start on
+// any rank count. Collective.
 // Throws std::runtime_error when it does not converge.
 BlockEigenPairs blockEigenpairs(const DirectSolver& shiftedInverse, Mat mass, double shift,
                                 const Eigen::MatrixXd& deflation, const DofLayout& layout,

@@ -4,6 +4,7 @@
 #include <climits>
 #include <stdexcept>
 
+#include "precompute/bake_context.h"
 #include "precompute/distributed_dense.h"
 
 namespace quiver {
@@ -31,11 +32,10 @@ std::vector<double> exchange(const std::vector<double>& send, const std::vector<
   return receive;
 }
 
-// Every rank learns whether any rank failed, so that none waits for ever in the next exchange.
+// Every rank learns the first failing rank's message, so that none waits for ever in the next exchange.
 void agreeOnFailure(const std::string& failure, MPI_Comm comm) {
-  int failed = failure.empty() ? 0 : 1, anyFailed = 0;
-  MPI_Allreduce(&failed, &anyFailed, 1, MPI_INT, MPI_MAX, comm);
-  if (anyFailed) throw std::runtime_error(failure.empty() ? std::string("another rank's factorization or solve failed") : failure);
+  const std::string first = firstRankError(failure, comm);
+  if (!first.empty()) throw std::runtime_error(first);
 }
 
 } // namespace
@@ -62,6 +62,9 @@ DirectSolver::DirectSolver(Mat A, const DofLayout& layout, const std::string& op
     QV_PETSC(PCSetType(pc, PCCHOLESKY));
     QV_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
     QV_PETSC(KSPSetFromOptions(ksp_));
+    // A failed factorization (MUMPS out of memory, a singular K) only marks the factor in PETSc
+    // 3.18; solves would then return Inf. This makes setup and solves raise instead.
+    QV_PETSC(KSPSetErrorIfNotConverged(ksp_, PETSC_TRUE));
     QV_PETSC(KSPSetUp(ksp_));
   } catch (const std::exception& e) {
     if (!redundant_) throw;  // collective calls: every rank throws alike
@@ -73,6 +76,7 @@ DirectSolver::DirectSolver(Mat A, const DofLayout& layout, const std::string& op
 Eigen::MatrixXd DirectSolver::solve(const Eigen::MatrixXd& B, Eigen::Index round,
                                     const ProgressCallback& progress) const {
   const Eigen::Index total = B.cols();
+  round = std::max<Eigen::Index>(round, 1);
   Eigen::MatrixXd X(B.rows(), total);
   if (!redundant_) {
     Eigen::MatrixXd b = B;  // PETSc wants writable arrays

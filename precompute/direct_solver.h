@@ -50,6 +50,7 @@ public:
     if (!solver_) solver_ = std::make_unique<DirectSolver>(stiffness_, layout_, "factor_");
     return *solver_;
   }
+  void release() { solver_.reset(); }
 
 private:
   Mat stiffness_;

@@ -34,8 +34,11 @@ void multiplyInto(Eigen::Ref<const Eigen::MatrixXd> A, bool transposeA, Eigen::R
                   double beta, Eigen::Ref<Eigen::MatrixXd> C) {
   const Eigen::Index inner = transposeA ? A.rows() : A.cols();
   if (C.size() == 0) return;
-  if (inner == 0) {
-    C *= beta;
+  if (inner == 0) {  // a rank without rows: its part of a product is zero (C may be uninitialised)
+    if (beta == 0)
+      C.setZero();
+    else
+      C *= beta;
     return;
   }
   cblas_dgemm(CblasColMajor, transposeA ? CblasTrans : CblasNoTrans, CblasNoTrans, static_cast<int>(C.rows()),

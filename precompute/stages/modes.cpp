@@ -197,7 +197,7 @@ std::vector<double> eigenResiduals(Mat stiffness, Mat mass, const std::vector<do
 LinearModes computeLinearModes(Mat stiffness, Mat mass, const DofLayout& layout, const ModeSettings& settings,
                                const Eigen::MatrixXd& rigid, StiffnessFactor* sharedFactor) {
   const int64_t available = layout.globalDofs() - rigid.cols();
-  if (settings.count > available)
+  if (settings.count >= available)
     throw std::runtime_error("cannot compute " + std::to_string(settings.count) + " modes of a system with " +
                              std::to_string(available) + " elastic degrees of freedom");
   // `wanted`: the solve that gives the modes (it reports progress; SLEPc's options apply to it).
@@ -230,7 +230,8 @@ LinearModes computeLinearModes(Mat stiffness, Mat mass, const DofLayout& layout,
     if (!(out.residuals[j] <= settings.maxResidual)) {
       std::ostringstream why;
       why << "mode " << j << " (lambda = " << out.eigenvalues[j] << ") has relative residual " << out.residuals[j]
-          << ", above " << settings.maxResidual << "; tighten -eps_tol";
+          << ", above " << settings.maxResidual
+          << (settings.solver == Eigensolver::KrylovSchur ? "; tighten -eps_tol" : "; try --eigensolver krylov-schur");
       throw std::runtime_error(why.str());
     }
   return out;

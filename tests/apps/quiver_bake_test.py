@@ -108,9 +108,11 @@ class QuiverBake(unittest.TestCase):
         subprocess.run([MESH, "beam", "--size", "1,0.1,0.1", "--cells", "30,4,4", "-o", beam], check=True)
         subprocess.run([MESH, "beam", "--size", "0.6,0.15,0.15", "--cells", "12,3,3", "-o", block], check=True)
         fixed = ["--fix", "x<min+1e-9", "--modes", "20", "--rank", "30"]
+        # SLEPc's solver takes other paths (SuperLU_DIST on 2 ranks, a factor per rank on 3).
+        slepc = ["--eigensolver", "krylov-schur"]
         for mesh, ranks, extra, runs in ((beam, 2, fixed, 3), (block, 2, ["--modes", "12", "--rank", "24"], 2),
-                                         (beam, 3, fixed, 2)):  # 3 ranks take another path (stages/modes.cpp)
-            names = [os.path.join(self.dir, f"{os.path.basename(mesh)}.{ranks}.{run}") for run in range(runs)]
+                                         (beam, 3, fixed, 2), (beam, 2, fixed + slepc, 2), (beam, 3, fixed + slepc, 2)):
+            names = [os.path.join(self.dir, f"{os.path.basename(mesh)}.{ranks}.{len(extra)}.{run}") for run in range(runs)]
             for name in names:  # the beam with its fidelity stage: /fidelity must repeat too
                 p = bake(ranks, mesh, *extra, "--quiet", "-o", name, fidelity=mesh == beam)
                 self.assertEqual(p.returncode, 0, p.stderr)
@@ -199,6 +201,9 @@ class QuiverBake(unittest.TestCase):
         p = bake(1, self.beam, "--basis", "svd", "-o", os.path.join(self.dir, "fewer"))
         self.assertNotEqual(p.returncode, 0)
         self.assertIn("svd not in {pca,keep-modes,modes}", p.stderr)
+        p = bake(1, self.beam, "--eigensolver", "lanczos", "-o", os.path.join(self.dir, "fewer"))
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn("lanczos not in {block,krylov-schur}", p.stderr)
 
     def test_fidelity_report(self):
         """The report's numbers: a basis of every free DOF is the full model, so every case reads 0%
