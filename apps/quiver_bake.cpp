@@ -46,11 +46,17 @@ int main(int argc, char** argv) {
   app.add_option("--density", s.mesh.material.density, "Density in kg/m^3 (> 0); overrides the mesh file's materials");
   app.add_option("--modes", s.modes, "Linear modes k (the six rigid modes of a free object are not counted)")
       ->capture_default_str();
+  std::vector<std::string> solvers;
+  for (Eigensolver solver : {Eigensolver::Block, Eigensolver::KrylovSchur}) solvers.push_back(eigensolverName(solver));
   app.add_option_function<std::string>(
-         "--eigensolver", [&](const std::string& name) { s.eigensolver = parseEigensolver(name); },
+         "--eigensolver",
+         [&s](const std::string& name) {
+           for (Eigensolver solver : {Eigensolver::Block, Eigensolver::KrylovSchur})
+             if (name == eigensolverName(solver)) s.eigensolver = solver;
+         },
          "How the modes are found: block (block Krylov-Schur, blocks of solves; default) or krylov-schur (SLEPc's, "
          "one solve at a time; its -eps_* and -st_* options apply)")
-      ->check(CLI::IsMember({"block", "krylov-schur"}));
+      ->check(CLI::IsMember(solvers));
   app.add_option("--rank", s.basis.settings.rank, "Basis vectors r, at most the free DOFs; fewer (with a warning) where --basis yields fewer")
       ->capture_default_str();
   std::vector<std::string> kinds;

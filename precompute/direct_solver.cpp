@@ -40,11 +40,12 @@ void agreeOnFailure(const std::string& failure, MPI_Comm comm) {
 
 } // namespace
 
-DirectSolver::DirectSolver(Mat A, const DofLayout& layout, const std::string& optionsPrefix) : layout_(layout) {
+DirectSolver::DirectSolver(Mat A, const DofLayout& layout) : layout_(layout) {
+  const char* prefix = "factor_";
   int size = 1;
   MPI_Comm_size(layout.comm(), &size);
   PetscBool distributed = PETSC_FALSE;
-  QV_PETSC(PetscOptionsGetBool(nullptr, optionsPrefix.c_str(), "-distributed", &distributed, nullptr));
+  QV_PETSC(PetscOptionsGetBool(nullptr, prefix, "-distributed", &distributed, nullptr));
   redundant_ = size > 1 && !distributed;
   const PetscInt* ranges = nullptr;
   QV_PETSC(MatGetOwnershipRanges(A, &ranges));
@@ -55,7 +56,7 @@ DirectSolver::DirectSolver(Mat A, const DofLayout& layout, const std::string& op
   try {
     PC pc;
     QV_PETSC(KSPCreate(PetscObjectComm(reinterpret_cast<PetscObject>(op)), ksp_.out()));
-    QV_PETSC(KSPSetOptionsPrefix(ksp_, optionsPrefix.c_str()));
+    QV_PETSC(KSPSetOptionsPrefix(ksp_, prefix));
     QV_PETSC(KSPSetOperators(ksp_, op, op));
     QV_PETSC(KSPSetType(ksp_, KSPPREONLY));
     QV_PETSC(KSPGetPC(ksp_, &pc));

@@ -5,8 +5,9 @@
 // schedules its work as messages arrive) and SuperLU_DIST's multi-right-hand-side solve corrupts its
 // heap in Debian 12 (pdReDistribute_B_to_X); so each rank factors the whole matrix alone and solves
 // its own share of the columns, whose bits depend on the inputs and the rank count only. That costs
-// a copy of the matrix and its factor per rank; -<prefix>distributed goes back to one distributed
-// factorization (less memory per rank, bits that may change). Options: -<prefix>pc_*, -<prefix>ksp_*.
+// a copy of the matrix and its factor per rank; -factor_distributed goes back to one distributed
+// factorization (less memory per rank, bits that may change). Options: -factor_pc_*,
+// -factor_mat_mumps_*, -factor_distributed.
 #include <functional>
 #include <memory>
 #include <string>
@@ -25,7 +26,7 @@ namespace quiver {
 class DirectSolver {
 public:
   // Factors A now (collective); A must outlive the solver. Throws std::runtime_error when it fails.
-  DirectSolver(Mat A, const DofLayout& layout, const std::string& optionsPrefix);
+  DirectSolver(Mat A, const DofLayout& layout);
 
   // X with A X = B (this rank's rows of both), at most `round` columns per factor solve, progress
   // after each round. Collective; a failure on any rank throws on every rank.
@@ -47,7 +48,7 @@ class StiffnessFactor {
 public:
   StiffnessFactor(Mat stiffness, const DofLayout& layout) : stiffness_(stiffness), layout_(layout) {}
   const DirectSolver& get() {
-    if (!solver_) solver_ = std::make_unique<DirectSolver>(stiffness_, layout_, "factor_");
+    if (!solver_) solver_ = std::make_unique<DirectSolver>(stiffness_, layout_);
     return *solver_;
   }
   void release() { solver_.reset(); }

@@ -20,13 +20,18 @@ Eigen::MatrixXd multiply(Mat A, const Eigen::MatrixXd& X, const DofLayout& layou
   PetscMat D = wrapDense(input, layout);
   PetscMat product;
   QV_PETSC(MatMatMult(A, D, MAT_INITIAL_MATRIX, PETSC_DEFAULT, product.out()));
+  return localRows(product, layout);
+}
+
+Eigen::MatrixXd localRows(Mat dense, const DofLayout& layout) {
+  PetscInt lda = 0, cols = 0;
   const PetscScalar* values = nullptr;
-  PetscInt lda = 0;
-  QV_PETSC(MatDenseGetLDA(product, &lda));
-  QV_PETSC(MatDenseGetArrayRead(product, &values));
-  Eigen::MatrixXd out = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>(
-      values, layout.localDofs(), X.cols(), Eigen::OuterStride<>(lda));
-  QV_PETSC(MatDenseRestoreArrayRead(product, &values));
+  QV_PETSC(MatGetSize(dense, nullptr, &cols));
+  QV_PETSC(MatDenseGetLDA(dense, &lda));
+  QV_PETSC(MatDenseGetArrayRead(dense, &values));
+  Eigen::MatrixXd out = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>(values, layout.localDofs(), cols,
+                                                                                  Eigen::OuterStride<>(lda));
+  QV_PETSC(MatDenseRestoreArrayRead(dense, &values));
   return out;
 }
 

@@ -14,6 +14,9 @@ PetscMat wrapDense(Eigen::MatrixXd& local, const DofLayout& layout);
 // The same for columns [first, first + count) of `local`.
 PetscMat wrapDenseColumns(Eigen::MatrixXd& local, Eigen::Index first, Eigen::Index count, const DofLayout& layout);
 
+// A copy of this rank's rows of a distributed dense matrix (whatever its leading dimension).
+Eigen::MatrixXd localRows(Mat dense, const DofLayout& layout);
+
 // This rank's rows of A X, for a distributed sparse A and row-distributed X. Collective.
 Eigen::MatrixXd multiply(Mat A, const Eigen::MatrixXd& X, const DofLayout& layout);
 

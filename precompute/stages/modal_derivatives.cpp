@@ -16,18 +16,6 @@ namespace quiver {
 
 namespace {
 
-Eigen::MatrixXd localBlock(Mat dense, const DofLayout& layout) {
-  PetscInt lda = 0, cols = 0;
-  const PetscScalar* values = nullptr;
-  QV_PETSC(MatGetSize(dense, nullptr, &cols));
-  QV_PETSC(MatDenseGetLDA(dense, &lda));
-  QV_PETSC(MatDenseGetArrayRead(dense, &values));
-  Eigen::MatrixXd out = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>(values, layout.localDofs(), cols,
-                                                                                  Eigen::OuterStride<>(lda));
-  QV_PETSC(MatDenseRestoreArrayRead(dense, &values));
-  return out;
-}
-
 // -d^2R[phi_i, phi_j] for every pair: this rank's rows (free DOFs x pairs). Each rank integrates its
 // own tets. Rows of its own DOFs add up in place, each DOF's pairs side by side (a tet adds 12
 // contiguous rows, not 12 x pairs scattered values); rows of DOFs another rank owns go there through
@@ -82,7 +70,7 @@ Eigen::MatrixXd rightHandSides(const TetMesh& mesh, const std::vector<Material>&
   if (size > 1) {
     QV_PETSC(MatAssemblyBegin(others, MAT_FINAL_ASSEMBLY));
     QV_PETSC(MatAssemblyEnd(others, MAT_FINAL_ASSEMBLY));
-    out += localBlock(others, layout);
+    out += localRows(others, layout);
   }
   return out;
 }
@@ -146,7 +134,7 @@ ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<
 
   // A fixed object's K may already be factored (the modes at shift 0); a free one's is pinned here.
   std::unique_ptr<DirectSolver> own;
-  if (freeObject || !sharedFactor) own = std::make_unique<DirectSolver>(op, layout, "factor_");
+  if (freeObject || !sharedFactor) own = std::make_unique<DirectSolver>(op, layout);
   const DirectSolver& solver = own ? *own : sharedFactor->get();
   out.vectors = solver.solve(solveFor, settings.blockSize, settings.progress);
   if (freeObject) out.vectors -= rigid * innerProducts(rigid, multiply(mass, out.vectors, layout), layout.comm());

@@ -145,9 +145,9 @@ EigenPairs blockKrylovSchur(Mat stiffness, Mat mass, const DofLayout& layout, do
   if (shift != 0) {
     QV_PETSC(MatDuplicate(stiffness, MAT_COPY_VALUES, shifted.out()));
     QV_PETSC(MatAXPY(shifted, -shift, mass, UNKNOWN_NONZERO_PATTERN));
-    own = std::make_unique<DirectSolver>(shifted, layout, "factor_");
+    own = std::make_unique<DirectSolver>(shifted, layout);
   } else if (!sharedFactor) {
-    own = std::make_unique<DirectSolver>(stiffness, layout, "factor_");
+    own = std::make_unique<DirectSolver>(stiffness, layout);
   }
   const DirectSolver& solver = own ? *own : sharedFactor->get();
   BlockEigenSettings settings;
@@ -256,12 +256,6 @@ LinearModes readModes(const Archive& archive, const DofLayout& layout) {
   modes.rigidSkipped = static_cast<int>(archive.intAttribute("/modes", "rigid_modes_skipped"));
   modes.shift = archive.doubleAttribute("/modes", "shift");
   return modes;
-}
-
-Eigensolver parseEigensolver(const std::string& name) {
-  if (name == "block") return Eigensolver::Block;
-  if (name == "krylov-schur") return Eigensolver::KrylovSchur;
-  throw std::invalid_argument("--eigensolver " + name + ": expected block or krylov-schur");
 }
 
 const char* eigensolverName(Eigensolver solver) {

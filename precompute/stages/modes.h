@@ -24,8 +24,7 @@
 namespace quiver {
 
 enum class Eigensolver { Block, KrylovSchur };
-// "block" or "krylov-schur"; throws std::invalid_argument otherwise.
-Eigensolver parseEigensolver(const std::string& name);
+// "block" or "krylov-schur".
 const char* eigensolverName(Eigensolver solver);
 
 struct ModeSettings {
