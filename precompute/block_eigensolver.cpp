@@ -113,14 +113,16 @@ BlockEigenPairs blockEigenpairs(const DirectSolver& shiftedInverse, Mat mass, do
   if (k < 1 || k >= room)
     throw std::invalid_argument("cannot compute " + std::to_string(k) + " eigenpairs in a space of " +
                                 std::to_string(room) + " dimensions");
-  // Blocks of 16 at k = 20 on the torus of bench/torus_bake.py: modes in 4.9 s on one rank (12: 5.0,
-  // 20: 5.4, 24: 5.7; larger blocks amortise the factor better but orthogonalise more).
-  const int b = settings.blockSize > 0 ? settings.blockSize : std::min(std::max(k, 4), 16);
+  // Each solve streams the whole factor (about 45 ms on the 97k-tet torus of bench/torus_bake.py)
+  // and then costs about 5 ms a column; larger blocks need more columns. There, at k = 20 on one
+  // rank with the basis room below: blocks of 4, 8, 12, 16 took 124, 172, 224, 260 columns and
+  // 3.8, 3.8, 4.1, 4.5 s; on two ranks, which share each block's columns, 8 took 3.1 s and 16 3.3 s.
+  const int b = settings.blockSize > 0 ? settings.blockSize : std::min(std::max(k, 4), 8);
   // The basis grows to `cap` columns, then restarts from its best k + b Ritz vectors; then Z (at
   // most b columns, M-orthogonal to the basis it came from) always fits beside what is kept. On the
-  // torus (k = b = 20) 4 blocks beyond k took 360 solves, 7 blocks 340 at nearly twice the
-  // orthogonalisation, 2 blocks 360 with more restarts.
-  const Eigen::Index cap = static_cast<Eigen::Index>(std::min<int64_t>(room, k + 4 * b));
+  // torus (k = 20, b = 8) k + 4b took 228 columns, k + 8b 196, k + 16b 172 (no restart: the room
+  // costs memory, n (cap + b) doubles twice, more than time).
+  const Eigen::Index cap = static_cast<Eigen::Index>(std::min<int64_t>(room, k + 16 * b));
   const int64_t maxColumns = 200 * static_cast<int64_t>(k + b);
   const Eigen::Index n = layout.localDofs();
 
@@ -198,6 +200,7 @@ BlockEigenPairs blockEigenpairs(const DirectSolver& shiftedInverse, Mat mass, do
       MV.leftCols(keep) = product(MV.leftCols(m), Y);
       T.topLeftCorner(keep, keep) = ritz.eigenvalues().tail(keep).asDiagonal();
       m = keep;
+      ++out.restarts;
     }
     append(Z, MZ);
   }

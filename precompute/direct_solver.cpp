@@ -41,23 +41,18 @@ void agreeOnFailure(const std::string& failure, MPI_Comm comm) {
 } // namespace
 
 DirectSolver::DirectSolver(Mat A, const DofLayout& layout) : layout_(layout) {
-  const char* prefix = "factor_";
   int size = 1;
   MPI_Comm_size(layout.comm(), &size);
   PetscBool distributed = PETSC_FALSE;
-  QV_PETSC(PetscOptionsGetBool(nullptr, prefix, "-distributed", &distributed, nullptr));
-  redundant_ = size > 1 && !distributed;
+  QV_PETSC(PetscOptionsGetBool(nullptr, "factor_", "-distributed", &distributed, nullptr));
   const PetscInt* ranges = nullptr;
   QV_PETSC(MatGetOwnershipRanges(A, &ranges));
   ranges_.assign(ranges, ranges + size + 1);
-  if (redundant_) QV_PETSC(MatCreateRedundantMatrix(A, size, MPI_COMM_NULL, MAT_INITIAL_MATRIX, whole_.out()));
-  Mat op = redundant_ ? whole_.get() : A;
-  std::string failure;
-  try {
+  if (distributed) {  // collective calls: every rank throws alike
     PC pc;
-    QV_PETSC(KSPCreate(PetscObjectComm(reinterpret_cast<PetscObject>(op)), ksp_.out()));
-    QV_PETSC(KSPSetOptionsPrefix(ksp_, prefix));
-    QV_PETSC(KSPSetOperators(ksp_, op, op));
+    QV_PETSC(KSPCreate(layout.comm(), ksp_.out()));
+    QV_PETSC(KSPSetOptionsPrefix(ksp_, "factor_"));
+    QV_PETSC(KSPSetOperators(ksp_, A, A));
     QV_PETSC(KSPSetType(ksp_, KSPPREONLY));
     QV_PETSC(KSPGetPC(ksp_, &pc));
     QV_PETSC(PCSetType(pc, PCCHOLESKY));
@@ -67,19 +62,26 @@ DirectSolver::DirectSolver(Mat A, const DofLayout& layout) : layout_(layout) {
     // 3.18; solves would then return Inf. This makes setup and solves raise instead.
     QV_PETSC(KSPSetErrorIfNotConverged(ksp_, PETSC_TRUE));
     QV_PETSC(KSPSetUp(ksp_));
+    return;
+  }
+  if (size > 1) QV_PETSC(MatCreateRedundantMatrix(A, size, MPI_COMM_NULL, MAT_INITIAL_MATRIX, whole_.out()));
+  std::string failure;
+  try {
+    factor_ = std::make_unique<SequentialCholesky>(size > 1 ? whole_.get() : A);
   } catch (const std::exception& e) {
-    if (!redundant_) throw;  // collective calls: every rank throws alike
     failure = e.what();
   }
-  if (redundant_) agreeOnFailure(failure, layout.comm());
+  agreeOnFailure(failure, layout.comm());
 }
+
+DirectSolver::~DirectSolver() = default;
 
 Eigen::MatrixXd DirectSolver::solve(const Eigen::MatrixXd& B, Eigen::Index round,
                                     const ProgressCallback& progress) const {
   const Eigen::Index total = B.cols();
   round = std::max<Eigen::Index>(round, 1);
   Eigen::MatrixXd X(B.rows(), total);
-  if (!redundant_) {
+  if (!factor_) {
     Eigen::MatrixXd b = B;  // PETSc wants writable arrays
     for (Eigen::Index first = 0; first < total; first += round) {
       const Eigen::Index count = std::min(round, total - first);
@@ -93,7 +95,6 @@ Eigen::MatrixXd DirectSolver::solve(const Eigen::MatrixXd& B, Eigen::Index round
   int rank = 0, size = 1;
   MPI_Comm_rank(layout_.comm(), &rank);
   MPI_Comm_size(layout_.comm(), &size);
-  const MPI_Comm self = PetscObjectComm(reinterpret_cast<PetscObject>(whole_.get()));
   auto rows = [&](int p) { return static_cast<Eigen::Index>(ranges_[p + 1] - ranges_[p]); };
   auto start = [&](int p) { return total * p / size; };  // rank p's columns: [start(p), start(p + 1))
   Eigen::Index most = 0, widest = 0;
@@ -121,19 +122,14 @@ Eigen::MatrixXd DirectSolver::solve(const Eigen::MatrixXd& B, Eigen::Index round
       receiveCounts[p] = static_cast<size_t>(rows(p) * mine);
     }
     std::vector<double> received = exchange(send, sendCounts, receiveCounts, layout_.comm());
-    Eigen::MatrixXd rhs(n, mine), x(n, mine);
+    Eigen::MatrixXd x(n, mine);  // the right-hand sides, then the solutions
     for (int p = 0, offset = 0; p < size; offset += static_cast<int>(receiveCounts[p]), ++p)
-      rhs.middleRows(ranges_[p], rows(p)) = Eigen::Map<const Eigen::MatrixXd>(received.data() + offset, rows(p), mine);
+      x.middleRows(ranges_[p], rows(p)) = Eigen::Map<const Eigen::MatrixXd>(received.data() + offset, rows(p), mine);
     std::string failure;
-    if (mine > 0) {
-      try {
-        PetscMat b, solution;
-        QV_PETSC(MatCreateSeqDense(self, n, mine, rhs.data(), b.out()));
-        QV_PETSC(MatCreateSeqDense(self, n, mine, x.data(), solution.out()));
-        QV_PETSC(KSPMatSolve(ksp_, b, solution));
-      } catch (const std::exception& e) {
-        failure = e.what();
-      }
+    try {
+      factor_->solveInPlace(x.data(), mine);
+    } catch (const std::exception& e) {
+      failure = e.what();
     }
     agreeOnFailure(failure, layout_.comm());
     // And back: each rank gets its rows of my columns.

@@ -1,12 +1,12 @@
 #pragma once
-// A Cholesky factorization (MUMPS) of a distributed symmetric positive definite matrix that solves
-// blocks of right-hand sides with the same bits every run (issue #16). On one rank it factors the
-// distributed matrix. On several, parallel MUMPS would give bits that change from run to run (it
-// schedules its work as messages arrive) and SuperLU_DIST's multi-right-hand-side solve corrupts its
-// heap in Debian 12 (pdReDistribute_B_to_X); so each rank factors the whole matrix alone and solves
-// its own share of the columns, whose bits depend on the inputs and the rank count only. That costs
-// a copy of the matrix and its factor per rank; -factor_distributed goes back to one distributed
-// factorization (less memory per rank, bits that may change). Options: -factor_pc_*,
+// A Cholesky factorization of a distributed symmetric positive definite matrix that solves blocks
+// of right-hand sides with the same bits every run (issue #16). Parallel MUMPS would give bits that
+// change from run to run (it schedules its work as messages arrive) and SuperLU_DIST's
+// multi-right-hand-side solve corrupts its heap in Debian 12 (pdReDistribute_B_to_X); so every rank
+// factors the whole matrix alone (SequentialCholesky) and solves its own share of the columns, whose
+// bits depend on the inputs and the rank count only. On several ranks that costs a copy of the
+// matrix and its factor per rank; -factor_distributed goes back to one distributed factorization
+// through PETSc (less memory per rank, bits that may change; -factor_pc_* applies there). Options:
 // -factor_mat_mumps_*, -factor_distributed.
 #include <functional>
 #include <memory>
@@ -19,6 +19,7 @@
 #include "precompute/dof_layout.h"
 #include "precompute/petsc_handle.h"
 #include "precompute/progress_meter.h"
+#include "precompute/sequential_cholesky.h"
 #include "precompute/stages/assemble.h"
 
 namespace quiver {
@@ -27,6 +28,7 @@ class DirectSolver {
 public:
   // Factors A now (collective); A must outlive the solver. Throws std::runtime_error when it fails.
   DirectSolver(Mat A, const DofLayout& layout);
+  ~DirectSolver();
 
   // X with A X = B (this rank's rows of both), at most `round` columns per factor solve, progress
   // after each round. Collective; a failure on any rank throws on every rank.
@@ -37,8 +39,8 @@ private:
   using PetscKsp = PetscHandle<KSP, KSPDestroy>;
   const DofLayout& layout_;
   PetscMat whole_;  // several ranks: this rank's copy of the whole matrix, on a communicator of one
-  PetscKsp ksp_;
-  bool redundant_ = false;
+  std::unique_ptr<SequentialCholesky> factor_;  // its factor (or A's on one rank)
+  PetscKsp ksp_;                                // or PETSc's distributed one (-factor_distributed)
   std::vector<PetscInt> ranges_;  // rows of each rank (PETSc's ownership ranges)
 };
 

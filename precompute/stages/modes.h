@@ -1,8 +1,8 @@
 #pragma once
 // Stage "modes": the lowest vibration modes K phi = lambda M phi of the free DOFs by shift-and-invert
 // with a direct solver, the same bits every run: by default a block Krylov-Schur
-// iteration over a Cholesky factor (block_eigensolver.h, DirectSolver: about 7 ms a right-hand side
-// in blocks against 51 ms for one alone on a 97k-tet torus), or SLEPc's
+// iteration over a Cholesky factor (block_eigensolver.h, DirectSolver: about 8 ms a right-hand side
+// in blocks of 8 against 45 ms for one alone on a 97k-tet torus), or SLEPc's
 // Krylov-Schur (--eigensolver krylov-schur; MUMPS on one rank, SuperLU_DIST on two, a sequential
 // MUMPS factor per rank on more; its -eps_* / -st_* options apply). On a free object (no fixed
 // vertex) K is singular: the six rigid motions are deflated (the solver works M-orthogonally to

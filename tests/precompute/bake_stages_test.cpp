@@ -8,6 +8,7 @@
 #include "common/box_mesh.h"
 #include "common/mass_matrix.h"
 #include "common/stvk_force_model.h"
+#include "precompute/block_eigensolver.h"
 #include "precompute/distributed_dense.h"
 #include "precompute/rigid_modes.h"
 #include "precompute/stages/assemble.h"
@@ -135,7 +136,30 @@ TEST_P(BakeStages, BlockSolverFindsAlmostEveryMode) {
   EXPECT_LT((phi.transpose() * p.M * phi - Eigen::MatrixXd::Identity(count, count)).cwiseAbs().maxCoeff(), 1e-9);
 }
 
-// Both solvers on a finer bar (960 free DOFs; the block solver restarts at k = 12).
+// The block solver's thick restarts, forced by blocks of 1 (room for k + 16 columns), on the finer
+// bar: the pairs still match the dense solve.
+TEST_P(BakeStages, BlockSolverRestartsAndStillMatchesTheDenseSolve) {
+  const bool free = GetParam();
+  Problem p(free, {16, 3, 4});
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ref(p.K, p.M);
+  const int skip = free ? 6 : 0;
+  // A free bar: the shift below the rigid modes' zero, as the modes stage takes it.
+  const double shift = free ? -0.01 * ref.eigenvalues()[skip] : 0;
+  PetscMat shifted;
+  QV_PETSC(MatDuplicate(p.system.stiffness, MAT_COPY_VALUES, shifted.out()));
+  QV_PETSC(MatAXPY(shifted, -shift, p.system.mass, SAME_NONZERO_PATTERN));
+  const DirectSolver solver(shifted, *p.layout);
+  BlockEigenSettings settings;
+  settings.count = 12;
+  settings.blockSize = 1;
+  const Eigen::MatrixXd deflation = free ? p.rigid : Eigen::MatrixXd(p.layout->localDofs(), 0);
+  const BlockEigenPairs pairs = blockEigenpairs(solver, p.system.mass, shift, deflation, *p.layout, settings);
+  EXPECT_GT(pairs.restarts, 0);
+  EXPECT_LT(maxRelative(pairs.values, ref.eigenvalues().segment(skip, 12)), 1e-10);
+  EXPECT_LT(subspaceGap(p.dense(pairs.vectors), ref.eigenvectors().middleCols(skip, 12), p.M), 1e-7);
+}
+
+// Both solvers on a finer bar (960 free DOFs).
 TEST_P(BakeStages, BothSolversMatchTheDenseSolveOnAFinerBar) {
   const bool free = GetParam();
   Problem p(free, {16, 3, 4});
@@ -165,6 +189,38 @@ TEST(BakeStages, DerivativesThroughTheSharedFactorAreTheSame) {
                                                           p.system.mass, *p.layout, modes, p.rigid, DerivativeSettings{},
                                                           &shared);
   EXPECT_EQ((own.vectors - reused.vectors).cwiseAbs().maxCoeff(), 0.0);
+}
+
+// -factor_distributed (PETSc's parallel MUMPS instead of a whole factor per rank) solves the same
+// systems: its modes and its derivatives of the same modes agree with the default's to round-off.
+TEST(BakeStages, DistributedFactorSolvesTheSameSystems) {
+  Problem p(false);
+  const LinearModes modes = p.modes(3);
+  const ModalDerivatives d = p.derivatives(modes);
+  // PETSc's numeric Cholesky runs only on that path: count its calls.
+  QV_PETSC(PetscLogDefaultBegin());
+  PetscLogEvent numeric = 0;
+  QV_PETSC(PetscLogEventGetId("MatCholFctrNum", &numeric));
+  auto factorizations = [&] {
+    PetscEventPerfInfo info{};
+    QV_PETSC(PetscLogEventGetPerfInfo(0, numeric, &info));
+    return info.count;
+  };
+  const int before = factorizations();
+  QV_PETSC(PetscOptionsSetValue(nullptr, "-factor_distributed", "1"));
+  LinearModes otherModes;
+  ModalDerivatives other;
+  EXPECT_NO_THROW({
+    otherModes = p.modes(3);
+    other = p.derivatives(modes);
+  });
+  QV_PETSC(PetscOptionsClearValue(nullptr, "-factor_distributed"));
+  EXPECT_EQ(factorizations() - before, 2);  // K for the modes, K again for the derivatives
+  ASSERT_EQ(otherModes.eigenvalues.size(), 3u);
+  EXPECT_LT(maxRelative(otherModes.eigenvalues, Eigen::Map<const Eigen::VectorXd>(modes.eigenvalues.data(), 3)), 1e-10);
+  EXPECT_LT(subspaceGap(p.dense(otherModes.vectors), p.dense(modes.vectors), p.M), 1e-7);
+  const Eigen::MatrixXd psi = p.dense(d.vectors);
+  EXPECT_LT((p.dense(other.vectors) - psi).norm(), 1e-10 * psi.norm());
 }
 
 TEST_P(BakeStages, DerivativesSolveTheDenseSystem) {
