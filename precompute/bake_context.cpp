@@ -73,6 +73,11 @@ void BakeContext::onRankZero(const std::function<void()>& work) const {
   if (!error.empty()) throw std::runtime_error(error);
 }
 
+void throwIfAnyRankFailed(const std::string& localError, MPI_Comm comm) {
+  const std::string first = firstRankError(localError, comm);
+  if (!first.empty()) throw std::runtime_error(first);
+}
+
 std::string BakeContext::agreeOnError(const std::string& localError) const {
   return firstRankError(localError, comm());
 }

@@ -44,6 +44,9 @@ private:
 
 // The same on any communicator: the lowest failing rank's error, tagged with its rank, on every rank.
 std::string firstRankError(const std::string& localError, MPI_Comm comm);
+// Collective: throws std::runtime_error with that error on every rank when any rank failed, so
+// that none waits for ever in the next collective call.
+void throwIfAnyRankFailed(const std::string& localError, MPI_Comm comm);
 
 // Splits a command line into the tool's own options and PETSc's. PETSc options are single-dash
 // options with names longer than one letter (-eps_type krylovschur, -log_view), each followed by

@@ -32,12 +32,6 @@ std::vector<double> exchange(const std::vector<double>& send, const std::vector<
   return receive;
 }
 
-// Every rank learns the first failing rank's message, so that none waits for ever in the next exchange.
-void agreeOnFailure(const std::string& failure, MPI_Comm comm) {
-  const std::string first = firstRankError(failure, comm);
-  if (!first.empty()) throw std::runtime_error(first);
-}
-
 } // namespace
 
 DirectSolver::DirectSolver(Mat A, const DofLayout& layout) : layout_(layout) {
@@ -64,14 +58,18 @@ DirectSolver::DirectSolver(Mat A, const DofLayout& layout) : layout_(layout) {
     QV_PETSC(KSPSetUp(ksp_));
     return;
   }
+  PetscInt maxInterface = 6000;  // a dense Schur complement of 288 MB per rank
+  QV_PETSC(PetscOptionsGetInt(nullptr, "factor_", "-max_interface", &maxInterface, nullptr));
+  split_ = SplitCholesky::tryCreate(A, layout.comm(), maxInterface);
+  if (split_) return;
   if (size > 1) QV_PETSC(MatCreateRedundantMatrix(A, size, MPI_COMM_NULL, MAT_INITIAL_MATRIX, whole_.out()));
   std::string failure;
   try {
-    factor_ = std::make_unique<SequentialCholesky>(size > 1 ? whole_.get() : A);
+    factor_ = std::make_unique<SequentialCholesky>(SequentialCholesky::upperTriangle(size > 1 ? whole_.get() : A));
   } catch (const std::exception& e) {
     failure = e.what();
   }
-  agreeOnFailure(failure, layout.comm());
+  throwIfAnyRankFailed(failure, layout.comm());
 }
 
 DirectSolver::~DirectSolver() = default;
@@ -81,7 +79,15 @@ Eigen::MatrixXd DirectSolver::solve(const Eigen::MatrixXd& B, Eigen::Index round
   const Eigen::Index total = B.cols();
   round = std::max<Eigen::Index>(round, 1);
   Eigen::MatrixXd X(B.rows(), total);
-  if (!factor_) {
+  if (split_) {
+    for (Eigen::Index first = 0; first < total; first += round) {
+      const Eigen::Index count = std::min(round, total - first);
+      split_->solve(B.col(first).data(), X.col(first).data(), count);
+      if (progress) progress(first + count, total);
+    }
+    return X;
+  }
+  if (ksp_.get()) {  // -factor_distributed
     Eigen::MatrixXd b = B;  // PETSc wants writable arrays
     for (Eigen::Index first = 0; first < total; first += round) {
       const Eigen::Index count = std::min(round, total - first);
@@ -131,7 +137,7 @@ Eigen::MatrixXd DirectSolver::solve(const Eigen::MatrixXd& B, Eigen::Index round
     } catch (const std::exception& e) {
       failure = e.what();
     }
-    agreeOnFailure(failure, layout_.comm());
+    throwIfAnyRankFailed(failure, layout_.comm());
     // And back: each rank gets its rows of my columns.
     send.clear();
     for (int p = 0; p < size; ++p) {

@@ -2,12 +2,16 @@
 // A Cholesky factorization of a distributed symmetric positive definite matrix that solves blocks
 // of right-hand sides with the same bits every run (issue #16). Parallel MUMPS would give bits that
 // change from run to run (it schedules its work as messages arrive) and SuperLU_DIST's
-// multi-right-hand-side solve corrupts its heap in Debian 12 (pdReDistribute_B_to_X); so every rank
-// factors the whole matrix alone (SequentialCholesky) and solves its own share of the columns, whose
-// bits depend on the inputs and the rank count only. On several ranks that costs a copy of the
-// matrix and its factor per rank; -factor_distributed goes back to one distributed factorization
-// through PETSc (less memory per rank, bits that may change; -factor_pc_* applies there). Options:
-// -factor_mat_mumps_*, -factor_distributed.
+// multi-right-hand-side solve corrupts its heap in Debian 12 (pdReDistribute_B_to_X). So:
+// - one rank: a SequentialCholesky of the matrix;
+// - several: a SplitCholesky (each rank factors its own interior, the interface between ranks is a
+//   dense Schur complement), when every rank has interior rows and the interface has at most
+//   -factor_max_interface rows (default 6000: a 288 MB Schur complement per rank);
+// - else every rank factors the whole matrix alone and solves its share of the columns (a copy of
+//   the matrix and its factor per rank).
+// Their bits depend on the inputs and the rank count only. -factor_distributed goes back to one
+// distributed factorization through PETSc (bits that may change; -factor_pc_* applies there).
+// Options: -factor_mat_mumps_*, -factor_max_interface, -factor_distributed.
 #include <functional>
 #include <memory>
 #include <string>
@@ -20,6 +24,7 @@
 #include "precompute/petsc_handle.h"
 #include "precompute/progress_meter.h"
 #include "precompute/sequential_cholesky.h"
+#include "precompute/split_cholesky.h"
 #include "precompute/stages/assemble.h"
 
 namespace quiver {
@@ -39,7 +44,8 @@ private:
   using PetscKsp = PetscHandle<KSP, KSPDestroy>;
   const DofLayout& layout_;
   PetscMat whole_;  // several ranks: this rank's copy of the whole matrix, on a communicator of one
-  std::unique_ptr<SequentialCholesky> factor_;  // its factor (or A's on one rank)
+  std::unique_ptr<SplitCholesky> split_;        // several ranks: a factor split by rank, or
+  std::unique_ptr<SequentialCholesky> factor_;  // the whole matrix's on each rank (or A's on one rank)
   PetscKsp ksp_;                                // or PETSc's distributed one (-factor_distributed)
   std::vector<PetscInt> ranges_;  // rows of each rank (PETSc's ownership ranges)
 };

@@ -38,15 +38,16 @@ std::string mumpsError(const DMUMPS_STRUC_C& id, const char* phase) {
   }
 }
 
-// Position of each DOF in a nested-dissection elimination order of the graph whose nodes are
-// blocks of `block` consecutive DOFs (a vertex's three), 1-based as MUMPS's PERM_IN wants it.
-// METIS's own random choices use a fixed seed: the same order every run.
-std::vector<MUMPS_INT> nestedDissection(const std::vector<MUMPS_INT>& rowOf, const std::vector<MUMPS_INT>& colOf,
-                                        PetscInt n, PetscInt block) {
-  const PetscInt nodes = n / block;
+// Position of each of the first `ordered` variables in a nested-dissection elimination order of
+// the graph whose nodes are blocks of `block` consecutive variables (a vertex's three), 1-based as
+// MUMPS's PERM_IN wants it; the rest (Schur variables) follow in their own order. METIS's own
+// random choices use a fixed seed: the same order every run.
+std::vector<MUMPS_INT> nestedDissection(const SequentialCholesky::UpperTriangle& upper, PetscInt ordered, PetscInt block) {
+  const PetscInt nodes = ordered / block;
   std::vector<std::vector<idx_t>> neighbours(static_cast<size_t>(nodes));
-  for (size_t e = 0; e < rowOf.size(); ++e) {
-    const idx_t a = (rowOf[e] - 1) / block, b = (colOf[e] - 1) / block;
+  for (size_t e = 0; e < upper.rows.size(); ++e) {
+    if (upper.cols[e] >= ordered) continue;  // rows[e] <= cols[e]
+    const idx_t a = upper.rows[e] / block, b = upper.cols[e] / block;
     if (a == b) continue;
     neighbours[a].push_back(b);
     neighbours[b].push_back(a);
@@ -60,16 +61,19 @@ std::vector<MUMPS_INT> nestedDissection(const std::vector<MUMPS_INT>& rowOf, con
     offsets[v + 1] = static_cast<idx_t>(adjacency.size());
     std::vector<idx_t>().swap(list);
   }
-  idx_t count = static_cast<idx_t>(nodes);
-  idx_t options[METIS_NOPTIONS];
-  METIS_SetDefaultOptions(options);
-  options[METIS_OPTION_NUMBERING] = 0;
-  std::vector<idx_t> order(static_cast<size_t>(nodes)), position(static_cast<size_t>(nodes));
-  if (METIS_NodeND(&count, offsets.data(), adjacency.data(), nullptr, options, order.data(), position.data()) != METIS_OK)
-    throw std::runtime_error("METIS_NodeND failed to order a graph of " + std::to_string(nodes) + " vertices");
-  std::vector<MUMPS_INT> perm(static_cast<size_t>(n));
-  for (PetscInt i = 0; i < n; ++i)
-    perm[i] = static_cast<MUMPS_INT>(block * position[i / block] + i % block + 1);
+  std::vector<MUMPS_INT> perm(static_cast<size_t>(upper.n));
+  if (nodes > 0) {
+    idx_t count = static_cast<idx_t>(nodes);
+    idx_t options[METIS_NOPTIONS];
+    METIS_SetDefaultOptions(options);
+    options[METIS_OPTION_NUMBERING] = 0;
+    std::vector<idx_t> order(static_cast<size_t>(nodes)), position(static_cast<size_t>(nodes));
+    if (METIS_NodeND(&count, offsets.data(), adjacency.data(), nullptr, options, order.data(), position.data()) != METIS_OK)
+      throw std::runtime_error("METIS_NodeND failed to order a graph of " + std::to_string(nodes) + " vertices");
+    for (PetscInt i = 0; i < ordered; ++i)
+      perm[i] = static_cast<MUMPS_INT>(block * position[i / block] + i % block + 1);
+  }
+  for (PetscInt i = ordered; i < upper.n; ++i) perm[i] = static_cast<MUMPS_INT>(i + 1);
   return perm;
 }
 
@@ -91,10 +95,13 @@ const LogEvents& events() {
 
 } // namespace
 
+static_assert(sizeof(MUMPS_INT) == sizeof(int), "MUMPS built with 64-bit integers");
+
 struct SequentialCholesky::Mumps {
   DMUMPS_STRUC_C id{};
-  std::vector<MUMPS_INT> rows, cols, perm;  // A's upper triangle (1-based), the elimination order
-  std::vector<double> values;
+  UpperTriangle upper;                     // 1-based once given to MUMPS
+  std::vector<MUMPS_INT> perm, schurList;  // the elimination order; the Schur variables (1-based)
+  Eigen::MatrixXd schur;                   // MUMPS writes the Schur complement here
   bool initialised = false;
   ~Mumps() {
     if (!initialised) return;
@@ -103,16 +110,14 @@ struct SequentialCholesky::Mumps {
   }
 };
 
-SequentialCholesky::SequentialCholesky(Mat A) : mumps_(std::make_unique<Mumps>()) {
-  PetscInt n = 0, columns = 0;
+SequentialCholesky::UpperTriangle SequentialCholesky::upperTriangle(Mat A) {
+  PetscInt n = 0, columns = 0, start = 0, end = 0;
   QV_PETSC(MatGetSize(A, &n, &columns));
-  PetscInt start = 0, end = 0;
   QV_PETSC(MatGetOwnershipRange(A, &start, &end));
   if (start != 0 || end != n || n != columns)
     throw std::logic_error("SequentialCholesky: the matrix must be square and held whole on this rank");
-  if (n > INT_MAX) throw std::runtime_error("SequentialCholesky: " + std::to_string(n) + " rows exceed MUMPS's int");
-  rows_ = n;
-  Mumps& m = *mumps_;
+  UpperTriangle upper;
+  upper.n = n;
   for (PetscInt i = 0; i < n; ++i) {
     PetscInt length = 0;
     const PetscInt* cols = nullptr;
@@ -120,12 +125,24 @@ SequentialCholesky::SequentialCholesky(Mat A) : mumps_(std::make_unique<Mumps>()
     QV_PETSC(MatGetRow(A, i, &length, &cols, &values));
     for (PetscInt e = 0; e < length; ++e)
       if (cols[e] >= i) {
-        m.rows.push_back(static_cast<MUMPS_INT>(i + 1));
-        m.cols.push_back(static_cast<MUMPS_INT>(cols[e] + 1));
-        m.values.push_back(values[e]);
+        upper.rows.push_back(static_cast<int>(i));
+        upper.cols.push_back(static_cast<int>(cols[e]));
+        upper.values.push_back(values[e]);
       }
     QV_PETSC(MatRestoreRow(A, i, &length, &cols, &values));
   }
+  return upper;
+}
+
+SequentialCholesky::SequentialCholesky(UpperTriangle upper, PetscInt schurSize)
+    : mumps_(std::make_unique<Mumps>()), rows_(upper.n), schurSize_(schurSize) {
+  const PetscInt n = upper.n;
+  if (n > INT_MAX) throw std::runtime_error("SequentialCholesky: " + std::to_string(n) + " rows exceed MUMPS's int");
+  if (schurSize < 0 || schurSize >= n)
+    throw std::logic_error("SequentialCholesky: " + std::to_string(schurSize) + " Schur variables of " +
+                           std::to_string(n) + " leave nothing to factor");
+  Mumps& m = *mumps_;
+  m.upper = std::move(upper);
 
   DMUMPS_STRUC_C& id = m.id;
   id.job = kInit;
@@ -152,15 +169,27 @@ SequentialCholesky::SequentialCholesky(Mat A) : mumps_(std::make_unique<Mumps>()
     QV_PETSC(PetscOptionsGetReal(nullptr, "factor_", ("-mat_mumps_cntl_" + std::to_string(i)).c_str(), &value, &set));
     if (set) id.cntl[i - 1] = value;
   }
-  id.n = static_cast<MUMPS_INT>(n);
-  id.nnz = static_cast<MUMPS_INT8>(m.values.size());
-  id.irn = m.rows.data();
-  id.jcn = m.cols.data();
-  id.a = m.values.data();
   PetscLogEventBegin(events().order, 0, 0, 0, 0);
+  const PetscInt ordered = n - schurSize;
   if (icntl(id, 7) == 1) {
-    m.perm = nestedDissection(m.rows, m.cols, n, n % 3 == 0 ? 3 : 1);
+    m.perm = nestedDissection(m.upper, ordered, ordered % 3 == 0 ? 3 : 1);
     id.perm_in = m.perm.data();
+  }
+  for (int& i : m.upper.rows) ++i;
+  for (int& j : m.upper.cols) ++j;
+  id.n = static_cast<MUMPS_INT>(n);
+  id.nnz = static_cast<MUMPS_INT8>(m.upper.values.size());
+  id.irn = m.upper.rows.data();
+  id.jcn = m.upper.cols.data();
+  id.a = m.upper.values.data();
+  if (schurSize > 0) {
+    for (PetscInt i = ordered; i < n; ++i) m.schurList.push_back(static_cast<MUMPS_INT>(i + 1));
+    m.schur = Eigen::MatrixXd::Zero(schurSize, schurSize);
+    icntl(id, 19) = 1;  // the Schur complement, centralised on this (the only) process
+    id.size_schur = static_cast<MUMPS_INT>(schurSize);
+    id.listvar_schur = m.schurList.data();
+    id.schur_lld = static_cast<MUMPS_INT>(schurSize);
+    id.schur = m.schur.data();
   }
   id.job = kAnalyse;
   dmumps_c(&id);
@@ -174,26 +203,52 @@ SequentialCholesky::SequentialCholesky(Mat A) : mumps_(std::make_unique<Mumps>()
   if (id.infog[11] > 0)
     throw std::runtime_error("the matrix to factor is not positive definite: " + std::to_string(id.infog[11]) +
                              " negative pivots in its Cholesky factorization");
+  // MUMPS returns the symmetric Schur complement's lower triangle by rows, the upper one column-major;
+  // what it leaves in the other triangle varies (all of it for small complements, zeros for large).
+  if (schurSize > 0) m.schur.triangularView<Eigen::StrictlyLower>() = m.schur.transpose();
 }
 
 SequentialCholesky::~SequentialCholesky() = default;
 
 int SequentialCholesky::orderingUsed() const { return mumps_->id.infog[6]; }
 
-void SequentialCholesky::solveInPlace(double* columns, PetscInt count) const {
+Eigen::MatrixXd SequentialCholesky::takeSchurComplement() {
+  mumps_->id.schur = nullptr;
+  return std::move(mumps_->schur);
+}
+
+void SequentialCholesky::solvePhase(double* columns, PetscInt count, int condensation, double* reduced) const {
   if (count <= 0) return;
   if (count > INT_MAX) throw std::runtime_error("SequentialCholesky: too many right-hand sides for one solve");
   DMUMPS_STRUC_C& id = mumps_->id;
-  id.icntl[19] = 0;  // ICNTL(20): dense right-hand sides, centralised
-  id.icntl[20] = 0;  // ICNTL(21): the solution overwrites them
+  icntl(id, 20) = 0;  // dense right-hand sides, centralised
+  icntl(id, 21) = 0;  // the solution overwrites them
+  icntl(id, 26) = condensation;
   id.nrhs = static_cast<MUMPS_INT>(count);
   id.lrhs = static_cast<MUMPS_INT>(rows_);
   id.rhs = columns;
+  id.redrhs = reduced;
+  id.lredrhs = static_cast<MUMPS_INT>(schurSize_);
   id.job = kSolve;
   PetscLogEventBegin(events().solve, 0, 0, 0, 0);
   dmumps_c(&id);
   PetscLogEventEnd(events().solve, 0, 0, 0, 0);
   if (id.infog[0] < 0) throw std::runtime_error(mumpsError(id, "solve"));
+}
+
+void SequentialCholesky::solveInPlace(double* columns, PetscInt count) const {
+  if (schurSize_ > 0) throw std::logic_error("SequentialCholesky: a factor with Schur variables solves in two steps");
+  solvePhase(columns, count, 0, nullptr);
+}
+
+void SequentialCholesky::condense(double* columns, PetscInt count, double* reduced) const {
+  if (schurSize_ == 0) throw std::logic_error("SequentialCholesky: no Schur variables to condense on");
+  solvePhase(columns, count, 1, reduced);
+}
+
+void SequentialCholesky::expand(double* columns, PetscInt count, const double* schurSolution) const {
+  if (schurSize_ == 0) throw std::logic_error("SequentialCholesky: no Schur variables to expand from");
+  solvePhase(columns, count, 2, const_cast<double*>(schurSolution));  // MUMPS only reads it here
 }
 
 } // namespace quiver

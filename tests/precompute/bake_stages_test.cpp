@@ -11,6 +11,7 @@
 #include "precompute/block_eigensolver.h"
 #include "precompute/distributed_dense.h"
 #include "precompute/rigid_modes.h"
+#include "precompute/split_cholesky.h"
 #include "precompute/stages/assemble.h"
 #include "precompute/stages/basis.h"
 #include "precompute/stages/modal_derivatives.h"
@@ -221,6 +222,26 @@ TEST(BakeStages, DistributedFactorSolvesTheSameSystems) {
   EXPECT_LT(subspaceGap(p.dense(otherModes.vectors), p.dense(modes.vectors), p.M), 1e-7);
   const Eigen::MatrixXd psi = p.dense(d.vectors);
   EXPECT_LT((p.dense(other.vectors) - psi).norm(), 1e-10 * psi.norm());
+}
+
+// The factor split by rank (a Schur complement on the interface) solves like a dense factor; on
+// one rank, or with no room for an interface, there is no split.
+TEST(BakeStages, SplitFactorSolvesLikeADenseFactor) {
+  int size = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  Problem p(false, {16, 3, 4});
+  const auto split = SplitCholesky::tryCreate(p.system.stiffness, MPI_COMM_WORLD, 100000);
+  EXPECT_EQ(split == nullptr, size == 1);
+  EXPECT_EQ(SplitCholesky::tryCreate(p.system.stiffness, MPI_COMM_WORLD, 0), nullptr);
+  if (!split) return;
+  EXPECT_GT(split->interfaceRows(), 0);
+  const Eigen::Index n = p.layout->localDofs();
+  Eigen::MatrixXd B(n, 3), X(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) B(i, c) = std::sin(1.0 + 0.37 * (p.layout->rowStart() + i) + c);
+  split->solve(B.data(), X.data(), 3);
+  const Eigen::MatrixXd expected = p.K.ldlt().solve(p.dense(B));
+  EXPECT_LT((p.dense(X) - expected).norm(), 1e-10 * expected.norm());
 }
 
 TEST_P(BakeStages, DerivativesSolveTheDenseSystem) {

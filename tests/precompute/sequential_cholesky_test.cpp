@@ -50,7 +50,7 @@ Eigen::MatrixXd gridMatrix(int a, int b, int c, int dofs, int drop, double shift
 PetscMat petscMatrix(const Eigen::MatrixXd& A) {
   PetscMat out;
   const PetscInt n = A.rows();
-  QV_PETSC(MatCreateSeqAIJ(PETSC_COMM_SELF, n, n, 40, nullptr, out.out()));
+  QV_PETSC(MatCreateSeqAIJ(PETSC_COMM_SELF, n, n, 400, nullptr, out.out()));
   for (PetscInt i = 0; i < n; ++i)
     for (PetscInt j = 0; j < n; ++j)
       if (A(i, j) != 0) QV_PETSC(MatSetValue(out, i, j, A(i, j), INSERT_VALUES));
@@ -73,7 +73,7 @@ TEST(SequentialCholesky, SolvesLikeADenseFactorInVertexTriplesAndNot) {
   for (int drop : {0, 1}) {  // 3 x 70 rows (the vertex graph), then 209 (each row a node)
     const Eigen::MatrixXd A = gridMatrix(7, 5, 2, 3, drop, 1e-3);
     const PetscMat matrix = petscMatrix(A);
-    const SequentialCholesky factor(matrix);
+    const SequentialCholesky factor(SequentialCholesky::upperTriangle(matrix));
     EXPECT_EQ(factor.rows(), A.rows());
     EXPECT_EQ(factor.orderingUsed(), 1);  // METIS's, given to MUMPS
     EXPECT_LT(relativeError(A, factor), 1e-12) << "rows " << A.rows();
@@ -85,7 +85,7 @@ TEST(SequentialCholesky, MumpsOwnOrderingWhenAskedGivesTheSameSolution) {
   const PetscMat matrix = petscMatrix(A);
   QV_PETSC(PetscOptionsSetValue(nullptr, "-factor_mat_mumps_icntl_7", "4"));  // PORD
   std::unique_ptr<SequentialCholesky> factor;
-  EXPECT_NO_THROW(factor = std::make_unique<SequentialCholesky>(matrix));
+  EXPECT_NO_THROW(factor = std::make_unique<SequentialCholesky>(SequentialCholesky::upperTriangle(matrix)));
   QV_PETSC(PetscOptionsClearValue(nullptr, "-factor_mat_mumps_icntl_7"));
   ASSERT_TRUE(factor);
   EXPECT_EQ(factor->orderingUsed(), 4);
@@ -97,10 +97,39 @@ TEST(SequentialCholesky, RefusesAnIndefiniteMatrix) {
   ASSERT_LT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(A).eigenvalues()[0], 0);
   const PetscMat matrix = petscMatrix(A);
   try {
-    SequentialCholesky factor(matrix);
+    SequentialCholesky factor(SequentialCholesky::upperTriangle(matrix));
     FAIL() << "an indefinite matrix was factored";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("not positive definite"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("negative pivots"), std::string::npos) << e.what();
+  }
+}
+
+// With the last variables left out: the Schur complement a dense elimination gives, and condense,
+// a dense solve on the Schur variables and expand together solve the whole system. A small Schur
+// block, and a large one with no entries of its own (as SplitCholesky gives it): MUMPS returns the
+// two differently.
+TEST(SequentialCholesky, SchurComplementAndTwoStepSolveMatchDenseAlgebra) {
+  for (const Eigen::Index s : {21, 300}) {
+    Eigen::MatrixXd A = gridMatrix(10, 8, 6, 3, 0, 1e-3);
+    const Eigen::Index n = A.rows(), m = n - s;
+    if (s > 100) A.bottomRightCorner(s, s).setZero();
+    SequentialCholesky factor(SequentialCholesky::upperTriangle(petscMatrix(A)), s);
+    const Eigen::MatrixXd S = factor.takeSchurComplement();
+    const Eigen::LDLT<Eigen::MatrixXd> interior(A.topLeftCorner(m, m));
+    const Eigen::MatrixXd reference = A.bottomRightCorner(s, s) - A.bottomLeftCorner(s, m) * interior.solve(A.topRightCorner(m, s));
+    ASSERT_EQ(S.rows(), s);
+    EXPECT_LT((S - reference).norm(), 1e-12 * reference.norm()) << s;
+    EXPECT_EQ(factor.takeSchurComplement().size(), 0);  // taken
+
+    const Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, 4);
+    Eigen::MatrixXd X = B, reduced(s, 4);
+    factor.condense(X.data(), 4, reduced.data());
+    const Eigen::MatrixXd expectedReduced = B.bottomRows(s) - A.bottomLeftCorner(s, m) * interior.solve(B.topRows(m));
+    EXPECT_LT((reduced - expectedReduced).norm(), 1e-12 * expectedReduced.norm()) << s;
+    const Eigen::MatrixXd schurSolution = reference.ldlt().solve(reduced);
+    factor.expand(X.data(), 4, schurSolution.data());
+    const Eigen::MatrixXd expected = A.ldlt().solve(B);
+    EXPECT_LT((X - expected).norm(), 1e-10 * expected.norm()) << s;
   }
 }
