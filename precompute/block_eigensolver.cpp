@@ -94,13 +94,8 @@ struct Orthonormalizer {
 
 // -log_view rows for the iteration's own work (the solves and M products have PETSc's).
 struct LogEvents {
-  PetscLogEvent orthogonalize = 0, rayleighRitz = 0;
-  LogEvents() {
-    PetscClassId id = 0;
-    PetscClassIdRegister("Block eigensolver", &id);
-    PetscLogEventRegister("BlkEigOrthog", id, &orthogonalize);
-    PetscLogEventRegister("BlkEigRitz", id, &rayleighRitz);
-  }
+  PetscLogEvent orthogonalize = registerLogEvent("Block eigensolver", "BlkEigOrthog");
+  PetscLogEvent rayleighRitz = registerLogEvent("Block eigensolver", "BlkEigRitz");
 };
 
 } // namespace

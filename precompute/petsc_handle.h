@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include <petsclog.h>
 #include <petscsys.h>
 
 namespace quiver {
@@ -49,6 +50,28 @@ public:
 
 private:
   T object_ = nullptr;
+};
+
+// A -log_view row of our own, under the class `className`. Register each once per process (keep
+// it in a function-local static).
+inline PetscLogEvent registerLogEvent(const char* className, const char* eventName) {
+  PetscClassId id = 0;
+  PetscLogEvent event = 0;
+  PetscClassIdRegister(className, &id);
+  PetscLogEventRegister(eventName, id, &event);
+  return event;
+}
+
+// Times its scope as `event` (ended on exceptions too).
+class LogEventScope {
+public:
+  explicit LogEventScope(PetscLogEvent event) : event_(event) { PetscLogEventBegin(event_, 0, 0, 0, 0); }
+  ~LogEventScope() { PetscLogEventEnd(event_, 0, 0, 0, 0); }
+  LogEventScope(const LogEventScope&) = delete;
+  LogEventScope& operator=(const LogEventScope&) = delete;
+
+private:
+  PetscLogEvent event_;
 };
 
 } // namespace quiver

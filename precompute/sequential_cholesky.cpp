@@ -79,14 +79,9 @@ std::vector<MUMPS_INT> nestedDissection(const SequentialCholesky::UpperTriangle&
 
 // -log_view rows (PETSc's own MatCholFctrNum and MatMatSolve do not see these calls).
 struct LogEvents {
-  PetscLogEvent order = 0, factor = 0, solve = 0;
-  LogEvents() {
-    PetscClassId id = 0;
-    PetscClassIdRegister("Sequential Cholesky", &id);
-    PetscLogEventRegister("SeqCholOrder", id, &order);
-    PetscLogEventRegister("SeqCholFactor", id, &factor);
-    PetscLogEventRegister("SeqCholSolve", id, &solve);
-  }
+  PetscLogEvent order = registerLogEvent("Sequential Cholesky", "SeqCholOrder");
+  PetscLogEvent factor = registerLogEvent("Sequential Cholesky", "SeqCholFactor");
+  PetscLogEvent solve = registerLogEvent("Sequential Cholesky", "SeqCholSolve");
 };
 const LogEvents& events() {
   static const LogEvents instance;
@@ -169,36 +164,38 @@ SequentialCholesky::SequentialCholesky(UpperTriangle upper, PetscInt schurSize)
     QV_PETSC(PetscOptionsGetReal(nullptr, "factor_", ("-mat_mumps_cntl_" + std::to_string(i)).c_str(), &value, &set));
     if (set) id.cntl[i - 1] = value;
   }
-  PetscLogEventBegin(events().order, 0, 0, 0, 0);
-  const PetscInt ordered = n - schurSize;
-  if (icntl(id, 7) == 1) {
-    m.perm = nestedDissection(m.upper, ordered, ordered % 3 == 0 ? 3 : 1);
-    id.perm_in = m.perm.data();
+  {
+    const LogEventScope timed(events().order);
+    const PetscInt ordered = n - schurSize;
+    if (icntl(id, 7) == 1) {
+      m.perm = nestedDissection(m.upper, ordered, ordered % 3 == 0 ? 3 : 1);
+      id.perm_in = m.perm.data();
+    }
+    for (int& i : m.upper.rows) ++i;
+    for (int& j : m.upper.cols) ++j;
+    id.n = static_cast<MUMPS_INT>(n);
+    id.nnz = static_cast<MUMPS_INT8>(m.upper.values.size());
+    id.irn = m.upper.rows.data();
+    id.jcn = m.upper.cols.data();
+    id.a = m.upper.values.data();
+    if (schurSize > 0) {
+      for (PetscInt i = ordered; i < n; ++i) m.schurList.push_back(static_cast<MUMPS_INT>(i + 1));
+      m.schur = Eigen::MatrixXd::Zero(schurSize, schurSize);
+      icntl(id, 19) = 1;  // the Schur complement, centralised on this (the only) process
+      id.size_schur = static_cast<MUMPS_INT>(schurSize);
+      id.listvar_schur = m.schurList.data();
+      id.schur_lld = static_cast<MUMPS_INT>(schurSize);
+      id.schur = m.schur.data();
+    }
+    id.job = kAnalyse;
+    dmumps_c(&id);
   }
-  for (int& i : m.upper.rows) ++i;
-  for (int& j : m.upper.cols) ++j;
-  id.n = static_cast<MUMPS_INT>(n);
-  id.nnz = static_cast<MUMPS_INT8>(m.upper.values.size());
-  id.irn = m.upper.rows.data();
-  id.jcn = m.upper.cols.data();
-  id.a = m.upper.values.data();
-  if (schurSize > 0) {
-    for (PetscInt i = ordered; i < n; ++i) m.schurList.push_back(static_cast<MUMPS_INT>(i + 1));
-    m.schur = Eigen::MatrixXd::Zero(schurSize, schurSize);
-    icntl(id, 19) = 1;  // the Schur complement, centralised on this (the only) process
-    id.size_schur = static_cast<MUMPS_INT>(schurSize);
-    id.listvar_schur = m.schurList.data();
-    id.schur_lld = static_cast<MUMPS_INT>(schurSize);
-    id.schur = m.schur.data();
-  }
-  id.job = kAnalyse;
-  dmumps_c(&id);
-  PetscLogEventEnd(events().order, 0, 0, 0, 0);
   if (id.infog[0] < 0) throw std::runtime_error(mumpsError(id, "analysis"));
   id.job = kFactor;
-  PetscLogEventBegin(events().factor, 0, 0, 0, 0);
-  dmumps_c(&id);
-  PetscLogEventEnd(events().factor, 0, 0, 0, 0);
+  {
+    const LogEventScope timed(events().factor);
+    dmumps_c(&id);
+  }
   if (id.infog[0] < 0) throw std::runtime_error(mumpsError(id, "factorization"));
   if (id.infog[11] > 0)
     throw std::runtime_error("the matrix to factor is not positive definite: " + std::to_string(id.infog[11]) +
@@ -230,9 +227,10 @@ void SequentialCholesky::solvePhase(double* columns, PetscInt count, int condens
   id.redrhs = reduced;
   id.lredrhs = static_cast<MUMPS_INT>(schurSize_);
   id.job = kSolve;
-  PetscLogEventBegin(events().solve, 0, 0, 0, 0);
-  dmumps_c(&id);
-  PetscLogEventEnd(events().solve, 0, 0, 0, 0);
+  {
+    const LogEventScope timed(events().solve);
+    dmumps_c(&id);
+  }
   if (id.infog[0] < 0) throw std::runtime_error(mumpsError(id, "solve"));
 }
 

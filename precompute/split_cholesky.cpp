@@ -36,13 +36,8 @@ std::vector<T> gatherInRankOrder(const T* mine, const std::vector<long long>& co
 
 // -log_view rows: the interface's part (the subdomains' is SequentialCholesky's).
 struct LogEvents {
-  PetscLogEvent factor = 0, solve = 0;
-  LogEvents() {
-    PetscClassId id = 0;
-    PetscClassIdRegister("Split Cholesky", &id);
-    PetscLogEventRegister("SplitSchurFactor", id, &factor);
-    PetscLogEventRegister("SplitSchurSolve", id, &solve);
-  }
+  PetscLogEvent factor = registerLogEvent("Split Cholesky", "SplitSchurFactor");
+  PetscLogEvent solve = registerLogEvent("Split Cholesky", "SplitSchurSolve");
 };
 const LogEvents& events() {
   static const LogEvents instance;
@@ -158,24 +153,25 @@ std::unique_ptr<SplitCholesky> SplitCholesky::tryCreate(Mat A, MPI_Comm comm, Pe
 
   // The whole Schur complement on every rank: the interface rows' own entries (each rank's rows,
   // transposed into columns of the symmetric whole), plus every rank's contribution in rank order.
-  PetscLogEventBegin(events().factor, 0, 0, 0, 0);
-  const Eigen::MatrixXd transposed = schurRows.transpose();
-  std::vector<long long> rowCounts = counts, contributionCounts(size);
-  for (int p = 0; p < size; ++p) {
-    rowCounts[p] *= total;
-    contributionCounts[p] = touchedCounts[p] * touchedCounts[p];
+  {
+    const LogEventScope timed(events().factor);
+    const Eigen::MatrixXd transposed = schurRows.transpose();
+    std::vector<long long> rowCounts = counts, contributionCounts(size);
+    for (int p = 0; p < size; ++p) {
+      rowCounts[p] *= total;
+      contributionCounts[p] = touchedCounts[p] * touchedCounts[p];
+    }
+    const std::vector<double> rows = gatherInRankOrder(transposed.data(), rowCounts, comm);
+    const std::vector<double> contributions = gatherInRankOrder(contribution.data(), contributionCounts, comm);
+    Eigen::MatrixXd whole = Eigen::Map<const Eigen::MatrixXd>(rows.data(), total, total);
+    for (int p = 0, offset = 0; p < size; offset += static_cast<int>(contributionCounts[p]), ++p) {
+      const auto& t = s.touched_[p];
+      const Eigen::Map<const Eigen::MatrixXd> c(contributions.data() + offset, t.size(), t.size());
+      for (size_t b = 0; b < t.size(); ++b)
+        for (size_t a = 0; a < t.size(); ++a) whole(t[a], t[b]) += c(a, b);
+    }
+    s.schurFactor_.compute(whole);
   }
-  const std::vector<double> rows = gatherInRankOrder(transposed.data(), rowCounts, comm);
-  const std::vector<double> contributions = gatherInRankOrder(contribution.data(), contributionCounts, comm);
-  Eigen::MatrixXd whole = Eigen::Map<const Eigen::MatrixXd>(rows.data(), total, total);
-  for (int p = 0, offset = 0; p < size; offset += static_cast<int>(contributionCounts[p]), ++p) {
-    const auto& t = s.touched_[p];
-    const Eigen::Map<const Eigen::MatrixXd> c(contributions.data() + offset, t.size(), t.size());
-    for (size_t b = 0; b < t.size(); ++b)
-      for (size_t a = 0; a < t.size(); ++a) whole(t[a], t[b]) += c(a, b);
-  }
-  s.schurFactor_.compute(whole);
-  PetscLogEventEnd(events().factor, 0, 0, 0, 0);
   if (s.schurFactor_.info() != Eigen::Success)
     throw std::runtime_error("split Cholesky: the Schur complement on the " + std::to_string(total) +
                              " interface rows is not positive definite");
@@ -205,24 +201,26 @@ void SplitCholesky::solve(const double* B, double* X, PetscInt count) const {
   throwIfAnyRankFailed(failure, comm_);
 
   // g = b_S + the contributions -A_SI A_II^-1 b_I, added in rank order; then x_S on every rank.
-  PetscLogEventBegin(events().solve, 0, 0, 0, 0);
-  std::vector<long long> borderCounts(size), reducedCounts(size);
-  for (int p = 0; p < size; ++p) {
-    borderCounts[p] = static_cast<long long>(interfaceCounts_[p]) * count;
-    reducedCounts[p] = static_cast<long long>(touched_[p].size()) * count;
+  Eigen::MatrixXd xS;
+  {
+    const LogEventScope timed(events().solve);
+    std::vector<long long> borderCounts(size), reducedCounts(size);
+    for (int p = 0; p < size; ++p) {
+      borderCounts[p] = static_cast<long long>(interfaceCounts_[p]) * count;
+      reducedCounts[p] = static_cast<long long>(touched_[p].size()) * count;
+    }
+    const std::vector<double> borders = gatherInRankOrder(border.data(), borderCounts, comm_);
+    const std::vector<double> contributions = gatherInRankOrder(reduced.data(), reducedCounts, comm_);
+    Eigen::MatrixXd g(schurFactor_.rows(), count);
+    for (int p = 0, offset = 0; p < size; offset += static_cast<int>(borderCounts[p]), ++p)
+      g.middleRows(interfaceOffsets_[p], interfaceCounts_[p]) =
+          Eigen::Map<const Eigen::MatrixXd>(borders.data() + offset, interfaceCounts_[p], count);
+    for (int p = 0, offset = 0; p < size; offset += static_cast<int>(reducedCounts[p]), ++p) {
+      const Eigen::Map<const Eigen::MatrixXd> c(contributions.data() + offset, touched_[p].size(), count);
+      for (Eigen::Index k = 0; k < c.rows(); ++k) g.row(touched_[p][k]) += c.row(k);
+    }
+    xS = schurFactor_.solve(g);
   }
-  const std::vector<double> borders = gatherInRankOrder(border.data(), borderCounts, comm_);
-  const std::vector<double> contributions = gatherInRankOrder(reduced.data(), reducedCounts, comm_);
-  Eigen::MatrixXd g(schurFactor_.rows(), count);
-  for (int p = 0, offset = 0; p < size; offset += static_cast<int>(borderCounts[p]), ++p)
-    g.middleRows(interfaceOffsets_[p], interfaceCounts_[p]) =
-        Eigen::Map<const Eigen::MatrixXd>(borders.data() + offset, interfaceCounts_[p], count);
-  for (int p = 0, offset = 0; p < size; offset += static_cast<int>(reducedCounts[p]), ++p) {
-    const Eigen::Map<const Eigen::MatrixXd> c(contributions.data() + offset, touched_[p].size(), count);
-    for (Eigen::Index k = 0; k < c.rows(); ++k) g.row(touched_[p][k]) += c.row(k);
-  }
-  const Eigen::MatrixXd xS = schurFactor_.solve(g);
-  PetscLogEventEnd(events().solve, 0, 0, 0, 0);
   Eigen::MatrixXd mineSolution(schurVariables, count);
   for (Eigen::Index k = 0; k < schurVariables; ++k) mineSolution.row(k) = xS.row(touched[k]);
   try {
