@@ -15,6 +15,8 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SEEDS = os.path.join(HERE, "seeds")
+# The seed folders this script writes; the others (drag_script, scenario) are written by hand.
+GENERATED = ("gmsh", "vtk", "vtu", "medit", "tetgen", "vega", "mfem", "bou", "npy", "qvr", "surface")
 
 # One unit cube cut into six Kuhn tets (positively oriented), plus one boundary triangle and
 # two regions, so that readers also meet skipped cells and region data.
@@ -43,6 +45,7 @@ def mesh(with_triangles=True):
 
 
 def write(fmt, name, **kwargs):
+    assert fmt in GENERATED, fmt
     folder = os.path.join(SEEDS, fmt)
     os.makedirs(folder, exist_ok=True)
     return os.path.join(folder, name)
@@ -146,7 +149,8 @@ def write_surface_seeds():
 
 
 def main():
-    shutil.rmtree(SEEDS, ignore_errors=True)
+    for fmt in GENERATED:
+        shutil.rmtree(os.path.join(SEEDS, fmt), ignore_errors=True)
     m = mesh()
     meshio.gmsh.write(write("gmsh", "ascii22.msh"), m, fmt_version="2.2", binary=False)
     meshio.gmsh.write(write("gmsh", "binary22.msh"), m, fmt_version="2.2", binary=True)
