@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -115,9 +116,10 @@ BlockEigenPairs blockEigenpairs(const DirectSolver& shiftedInverse, Mat mass, do
   const int b = settings.blockSize > 0 ? settings.blockSize : std::min(std::max(k, 4), 8);
   // The basis grows to `cap` columns, then restarts from its best k + b Ritz vectors; then Z (at
   // most b columns, M-orthogonal to the basis it came from) always fits beside what is kept. On the
-  // torus (k = 20, b = 8) k + 4b took 228 columns, k + 8b 196, k + 16b 172 (no restart: the room
-  // costs memory, n (cap + b) doubles twice, more than time).
-  const Eigen::Index cap = static_cast<Eigen::Index>(std::min<int64_t>(room, k + 16 * b));
+  // torus (k = 20, b = 8) room for k + 32 columns took 228 solves, k + 64 196, k + 128 172 (one
+  // restart); the room costs memory, n (cap + b) doubles twice, more than time.
+  const int64_t asked = settings.basisColumns > 0 ? std::max(settings.basisColumns, k + 2 * b) : k + std::max(4 * b, 128);
+  const Eigen::Index cap = static_cast<Eigen::Index>(std::min<int64_t>(room, asked));
   const int64_t maxColumns = 200 * static_cast<int64_t>(k + b);
   const Eigen::Index n = layout.localDofs();
 
@@ -149,10 +151,12 @@ BlockEigenPairs blockEigenpairs(const DirectSolver& shiftedInverse, Mat mass, do
     Z = shiftedInverse.solve(MV.middleCols(m - last, last));
     out.solvedColumns += static_cast<int>(last);
     MatrixXd residualGram;  // of what the last block's image leaves outside the basis
-    PetscLogEventBegin(events.orthogonalize, 0, 0, 0, 0);
-    const MatrixXd c = orthonormalize(V.leftCols(m), MV.leftCols(m), Z, MZ, &residualGram);
-    PetscLogEventEnd(events.orthogonalize, 0, 0, 0, 0);
-    PetscLogEventBegin(events.rayleighRitz, 0, 0, 0, 0);
+    MatrixXd c;
+    {
+      const LogEventScope timed(events.orthogonalize);
+      c = orthonormalize(V.leftCols(m), MV.leftCols(m), Z, MZ, &residualGram);
+    }
+    std::optional<LogEventScope> ritzTimed(std::in_place, events.rayleighRitz);
     T.block(0, m - last, m, last) = c;
     T.block(m - last, 0, last, m) = c.transpose();
     T.block(m - last, m - last, last, last) = 0.5 * (c.bottomRows(last) + c.bottomRows(last).transpose());
@@ -171,7 +175,7 @@ BlockEigenPairs blockEigenpairs(const DirectSolver& shiftedInverse, Mat mass, do
       if (ritz.eigenvalues()[col] > 0 && residual <= settings.tolerance * largest) ++converged;
     }
     if (settings.progress) settings.progress(converged, k);
-    PetscLogEventEnd(events.rayleighRitz, 0, 0, 0, 0);
+    ritzTimed.reset();
     if (converged == k) {
       // Purified Ritz vectors x = (K - sigma M)^-1 M (V y) / theta, as SLEPc's: the residual V y
       // leaves lies along the stiff modes, which K multiplies by their large eigenvalues; one

@@ -3,7 +3,7 @@
 // iteration with shift-and-invert: Rayleigh-Ritz on a block Krylov space of (K - sigma M)^-1 M,
 // M-orthonormal, thick restarts keeping the best Ritz vectors. It exists for one reason: blocks.
 // A triangular solve with one right-hand side streams the whole factor for little arithmetic; in
-// blocks each column costs far less (on a 97k-tet torus: 51 ms for one, about 8 ms a column in
+// blocks each column costs far less (on a 97k-tet torus: 45 ms for one, about 8 ms a column in
 // blocks of eight), and SLEPc's Krylov-Schur solves one vector at a time. SLEPc's LOBPCG, which calls the
 // blocked solve, broke down in its Gram matrix (DSSolve_GHEP) on that torus; Trilinos' Anasazi
 // BlockKrylovSchur (Debian has it) needed 260-1200 solves there and an M product per
@@ -24,6 +24,7 @@ struct BlockEigenSettings {
   int count = 20;            // eigenpairs wanted
   double tolerance = 1e-12;  // ||(K - sigma M)^-1 M x - theta x||_M / theta_1, x M-normalised, theta = 1 / (lambda - sigma)
   int blockSize = 0;         // 0: min(max(count, 4), 8); -modes_block_size in the bake
+  int basisColumns = 0;      // the basis's room before a thick restart; 0: count + max(4 blockSize, 128)
   ProgressCallback progress; // (converged, count)
 };
 

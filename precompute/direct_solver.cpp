@@ -60,12 +60,15 @@ DirectSolver::DirectSolver(Mat A, const DofLayout& layout) : layout_(layout) {
   }
   PetscInt maxInterface = 6000;  // a dense Schur complement of 288 MB per rank
   QV_PETSC(PetscOptionsGetInt(nullptr, "factor_", "-max_interface", &maxInterface, nullptr));
+  if (maxInterface > 46340)  // a dense Schur complement gathered in one MPI call of int counts
+    throw std::runtime_error("-factor_max_interface " + std::to_string(maxInterface) + " exceeds 46340");
   split_ = SplitCholesky::tryCreate(A, layout.comm(), maxInterface);
   if (split_) return;
-  if (size > 1) QV_PETSC(MatCreateRedundantMatrix(A, size, MPI_COMM_NULL, MAT_INITIAL_MATRIX, whole_.out()));
+  PetscMat whole;  // several ranks: this rank's copy of the whole matrix, on a communicator of one
+  if (size > 1) QV_PETSC(MatCreateRedundantMatrix(A, size, MPI_COMM_NULL, MAT_INITIAL_MATRIX, whole.out()));
   std::string failure;
   try {
-    factor_ = std::make_unique<SequentialCholesky>(SequentialCholesky::upperTriangle(size > 1 ? whole_.get() : A));
+    factor_ = std::make_unique<SequentialCholesky>(SequentialCholesky::upperTriangle(size > 1 ? whole.get() : A));
   } catch (const std::exception& e) {
     failure = e.what();
   }

@@ -43,7 +43,6 @@ public:
 private:
   using PetscKsp = PetscHandle<KSP, KSPDestroy>;
   const DofLayout& layout_;
-  PetscMat whole_;  // several ranks: this rank's copy of the whole matrix, on a communicator of one
   std::unique_ptr<SplitCholesky> split_;        // several ranks: a factor split by rank, or
   std::unique_ptr<SequentialCholesky> factor_;  // the whole matrix's on each rank (or A's on one rank)
   PetscKsp ksp_;                                // or PETSc's distributed one (-factor_distributed)

@@ -32,7 +32,7 @@ std::string mumpsError(const DMUMPS_STRUC_C& id, const char* phase) {
     return what + ": the matrix is numerically singular (are enough vertices fixed?)";
   case -13:
     return what + ": out of memory allocating " + std::to_string(detail < 0 ? -static_cast<long long>(detail) * 1000000LL
-                                                                            : static_cast<long long>(detail)) + " bytes";
+                                                                            : static_cast<long long>(detail)) + " entries";
   default:
     return what + "; see the MUMPS users' guide, section \"Error diagnostics\"";
   }
@@ -62,7 +62,8 @@ std::vector<MUMPS_INT> nestedDissection(const SequentialCholesky::UpperTriangle&
     std::vector<idx_t>().swap(list);
   }
   std::vector<MUMPS_INT> perm(static_cast<size_t>(upper.n));
-  if (nodes > 0) {
+  for (PetscInt i = 0; i < upper.n; ++i) perm[i] = static_cast<MUMPS_INT>(i + 1);
+  if (!adjacency.empty()) {  // METIS reads its adjacency even for a graph without edges
     idx_t count = static_cast<idx_t>(nodes);
     idx_t options[METIS_NOPTIONS];
     METIS_SetDefaultOptions(options);
@@ -73,7 +74,6 @@ std::vector<MUMPS_INT> nestedDissection(const SequentialCholesky::UpperTriangle&
     for (PetscInt i = 0; i < ordered; ++i)
       perm[i] = static_cast<MUMPS_INT>(block * position[i / block] + i % block + 1);
   }
-  for (PetscInt i = ordered; i < upper.n; ++i) perm[i] = static_cast<MUMPS_INT>(i + 1);
   return perm;
 }
 
@@ -153,6 +153,7 @@ SequentialCholesky::SequentialCholesky(UpperTriangle upper, PetscInt schurSize)
   icntl(id, 4) = 0;  // silent unless -factor_mat_mumps_icntl_4 asks
   icntl(id, 7) = 1;  // our order (perm_in)
   for (int i = 1; i <= 60; ++i) {
+    if (i == 19 || i == 20 || i == 21 || i == 26) continue;  // the Schur and right-hand-side layout: ours
     PetscInt value = 0;
     PetscBool set = PETSC_FALSE;
     QV_PETSC(PetscOptionsGetInt(nullptr, "factor_", ("-mat_mumps_icntl_" + std::to_string(i)).c_str(), &value, &set));
@@ -191,6 +192,8 @@ SequentialCholesky::SequentialCholesky(UpperTriangle upper, PetscInt schurSize)
     dmumps_c(&id);
   }
   if (id.infog[0] < 0) throw std::runtime_error(mumpsError(id, "analysis"));
+  std::vector<MUMPS_INT>().swap(m.perm);  // read by the analysis only
+  id.perm_in = nullptr;
   id.job = kFactor;
   {
     const LogEventScope timed(events().factor);
@@ -200,6 +203,11 @@ SequentialCholesky::SequentialCholesky(UpperTriangle upper, PetscInt schurSize)
   if (id.infog[11] > 0)
     throw std::runtime_error("the matrix to factor is not positive definite: " + std::to_string(id.infog[11]) +
                              " negative pivots in its Cholesky factorization");
+  if (icntl(id, 10) == 0 && icntl(id, 11) == 0) {  // the solves read the matrix only to refine or analyse errors
+    m.upper = UpperTriangle();
+    id.irn = id.jcn = nullptr;
+    id.a = nullptr;
+  }
   // MUMPS returns the symmetric Schur complement's lower triangle by rows, the upper one column-major;
   // what it leaves in the other triangle varies (all of it for small complements, zeros for large).
   if (schurSize > 0) m.schur.triangularView<Eigen::StrictlyLower>() = m.schur.transpose();

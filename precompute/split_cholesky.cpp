@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <Eigen/Cholesky>
+
 #include "precompute/bake_context.h"
 #include "precompute/petsc_handle.h"
 
@@ -16,9 +18,9 @@ template <class T> MPI_Datatype mpiType();
 template <> MPI_Datatype mpiType<double>() { return MPI_DOUBLE; }
 template <> MPI_Datatype mpiType<int>() { return MPI_INT; }
 
-// MPI_Allgatherv of `mine` with every rank's count; the blocks land in rank order.
+// MPI_Allgatherv of `mine` with every rank's count into `all`; the blocks land in rank order.
 template <class T>
-std::vector<T> gatherInRankOrder(const T* mine, const std::vector<long long>& counts, MPI_Comm comm) {
+void gatherInRankOrder(const T* mine, const std::vector<long long>& counts, T* all, MPI_Comm comm) {
   std::vector<int> c(counts.size()), offsets(counts.size());
   long long total = 0;
   for (size_t p = 0; p < counts.size(); ++p) {
@@ -29,8 +31,15 @@ std::vector<T> gatherInRankOrder(const T* mine, const std::vector<long long>& co
   }
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
-  std::vector<T> all(static_cast<size_t>(total));
-  MPI_Allgatherv(mine, c[rank], mpiType<T>(), all.data(), c.data(), offsets.data(), mpiType<T>(), comm);
+  MPI_Allgatherv(mine, c[rank], mpiType<T>(), all, c.data(), offsets.data(), mpiType<T>(), comm);
+}
+
+template <class T>
+std::vector<T> gatherInRankOrder(const T* mine, const std::vector<long long>& counts, MPI_Comm comm) {
+  long long total = 0;
+  for (long long c : counts) total += c;
+  std::vector<T> all(static_cast<size_t>(std::max(total, 0LL)));
+  gatherInRankOrder(mine, counts, all.data(), comm);
   return all;
 }
 
@@ -91,21 +100,31 @@ std::unique_ptr<SplitCholesky> SplitCholesky::tryCreate(Mat A, MPI_Comm comm, Pe
   if (fewestInterior == 0 || total > maxInterface) return nullptr;
   const std::vector<long long> counts(s.interfaceCounts_.begin(), s.interfaceCounts_.end());
   const std::vector<double> interfaceRows = gatherInRankOrder(mineRows.data(), counts, comm);
+  // Its index in the interface, or -1 (a column that is no interface row).
   auto interfaceIndex = [&](PetscInt j) {
-    return static_cast<int>(std::lower_bound(interfaceRows.begin(), interfaceRows.end(), static_cast<double>(j)) -
-                            interfaceRows.begin());
+    const auto at = std::lower_bound(interfaceRows.begin(), interfaceRows.end(), static_cast<double>(j));
+    return at != interfaceRows.end() && *at == static_cast<double>(j) ? static_cast<int>(at - interfaceRows.begin()) : -1;
   };
 
   // The interface indices this rank's interior touches (its Schur variables), then the local
   // matrix: interior rows first, those after; its Schur block is left empty (zero), so that MUMPS
   // returns the interior's contribution -A_SI A_II^-1 A_IS alone. The interface rows' own entries
   // go straight into this rank's rows of the whole Schur complement.
+  // An interior row's column of another rank is an interface row when A's pattern is symmetric.
   std::vector<int> touched;
+  std::string failure;
   forEachRow([&](PetscInt i, const PetscInt* cols, const PetscScalar*, PetscInt length) {
     if (s.position_[i - start] < 0) return;
     for (PetscInt e = 0; e < length; ++e)
-      if (cols[e] < start || s.position_[cols[e] - start] < 0) touched.push_back(interfaceIndex(cols[e]));
+      if (cols[e] < start || s.position_[cols[e] - start] < 0) {
+        const int k = interfaceIndex(cols[e]);
+        if (k < 0 && failure.empty())
+          failure = "split Cholesky: the matrix is not structurally symmetric (row " + std::to_string(i) +
+                    " has column " + std::to_string(cols[e]) + ", whose row has no column " + std::to_string(i) + ")";
+        if (k >= 0) touched.push_back(k);
+      }
   });
+  throwIfAnyRankFailed(failure, comm);
   std::sort(touched.begin(), touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
   SequentialCholesky::UpperTriangle upper;
@@ -117,8 +136,7 @@ std::unique_ptr<SplitCholesky> SplitCholesky::tryCreate(Mat A, MPI_Comm comm, Pe
       const bool ownInterior = cols[e] >= start && cols[e] < end && s.position_[cols[e] - start] >= 0;
       if (li < 0) {  // an interface row: its entries in interface columns (the others are interior rows')
         const int k = interfaceIndex(cols[e]);
-        if (!ownInterior && k < total && interfaceRows[k] == static_cast<double>(cols[e]))
-          schurRows(-1 - li, k) = values[e];
+        if (!ownInterior && k >= 0) schurRows(-1 - li, k) = values[e];
         continue;
       }
       PetscInt lj = 0;
@@ -142,7 +160,6 @@ std::unique_ptr<SplitCholesky> SplitCholesky::tryCreate(Mat A, MPI_Comm comm, Pe
     s.touched_.emplace_back(allTouched.begin() + offset, allTouched.begin() + offset + touchedCounts[p]);
 
   Eigen::MatrixXd contribution;
-  std::string failure;
   try {
     s.factor_ = std::make_unique<SequentialCholesky>(std::move(upper), static_cast<PetscInt>(touched.size()));
     contribution = s.factor_->takeSchurComplement();
@@ -161,20 +178,21 @@ std::unique_ptr<SplitCholesky> SplitCholesky::tryCreate(Mat A, MPI_Comm comm, Pe
       rowCounts[p] *= total;
       contributionCounts[p] = touchedCounts[p] * touchedCounts[p];
     }
-    const std::vector<double> rows = gatherInRankOrder(transposed.data(), rowCounts, comm);
+    s.schur_.resize(total, total);
+    gatherInRankOrder(transposed.data(), rowCounts, s.schur_.data(), comm);
     const std::vector<double> contributions = gatherInRankOrder(contribution.data(), contributionCounts, comm);
-    Eigen::MatrixXd whole = Eigen::Map<const Eigen::MatrixXd>(rows.data(), total, total);
     for (int p = 0, offset = 0; p < size; offset += static_cast<int>(contributionCounts[p]), ++p) {
       const auto& t = s.touched_[p];
       const Eigen::Map<const Eigen::MatrixXd> c(contributions.data() + offset, t.size(), t.size());
       for (size_t b = 0; b < t.size(); ++b)
-        for (size_t a = 0; a < t.size(); ++a) whole(t[a], t[b]) += c(a, b);
+        for (size_t a = 0; a < t.size(); ++a) s.schur_(t[a], t[b]) += c(a, b);
     }
-    s.schurFactor_.compute(whole);
+    // In place: the lower triangle becomes L (S = L L^T), no second dense copy.
+    const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> factor(s.schur_);
+    if (factor.info() != Eigen::Success)
+      throw std::runtime_error("the matrix to factor is not positive definite (its Schur complement on the " +
+                               std::to_string(total) + " rows between ranks is not)");
   }
-  if (s.schurFactor_.info() != Eigen::Success)
-    throw std::runtime_error("split Cholesky: the Schur complement on the " + std::to_string(total) +
-                             " interface rows is not positive definite");
   return split;
 }
 
@@ -211,7 +229,7 @@ void SplitCholesky::solve(const double* B, double* X, PetscInt count) const {
     }
     const std::vector<double> borders = gatherInRankOrder(border.data(), borderCounts, comm_);
     const std::vector<double> contributions = gatherInRankOrder(reduced.data(), reducedCounts, comm_);
-    Eigen::MatrixXd g(schurFactor_.rows(), count);
+    Eigen::MatrixXd g(schur_.rows(), count);
     for (int p = 0, offset = 0; p < size; offset += static_cast<int>(borderCounts[p]), ++p)
       g.middleRows(interfaceOffsets_[p], interfaceCounts_[p]) =
           Eigen::Map<const Eigen::MatrixXd>(borders.data() + offset, interfaceCounts_[p], count);
@@ -219,7 +237,10 @@ void SplitCholesky::solve(const double* B, double* X, PetscInt count) const {
       const Eigen::Map<const Eigen::MatrixXd> c(contributions.data() + offset, touched_[p].size(), count);
       for (Eigen::Index k = 0; k < c.rows(); ++k) g.row(touched_[p][k]) += c.row(k);
     }
-    xS = schurFactor_.solve(g);
+    const auto L = schur_.triangularView<Eigen::Lower>();
+    L.solveInPlace(g);
+    L.transpose().solveInPlace(g);
+    xS = std::move(g);
   }
   Eigen::MatrixXd mineSolution(schurVariables, count);
   for (Eigen::Index k = 0; k < schurVariables; ++k) mineSolution.row(k) = xS.row(touched[k]);

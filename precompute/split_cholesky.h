@@ -13,7 +13,6 @@
 #include <memory>
 #include <vector>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <mpi.h>
 #include <petscmat.h>
@@ -33,7 +32,7 @@ public:
   // row count). Collective, with the same `count` on every rank.
   void solve(const double* B, double* X, PetscInt count) const;
 
-  PetscInt interfaceRows() const { return static_cast<PetscInt>(schurFactor_.rows()); }
+  PetscInt interfaceRows() const { return static_cast<PetscInt>(schur_.rows()); }
 
 private:
   SplitCholesky() = default;
@@ -44,7 +43,7 @@ private:
   std::vector<int> interfaceCounts_, interfaceOffsets_;  // each rank's interface rows (contiguous, in rank order)
   std::vector<std::vector<int>> touched_;  // each rank's Schur variables: interface indices its interior touches
   std::unique_ptr<SequentialCholesky> factor_;
-  Eigen::LLT<Eigen::MatrixXd> schurFactor_;
+  Eigen::MatrixXd schur_;  // the interface's Schur complement's Cholesky factor L, in its lower triangle
 };
 
 } // namespace quiver

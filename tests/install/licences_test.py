@@ -20,6 +20,8 @@ AUDITED = {
     "libmpi_cxx.so.40": "BSD-3-Clause (Open MPI)",
     "libhdf5_openmpi.so.103": "BSD-3-Clause (HDF5)",
     "libmetis.so.5": "Apache-2.0 (METIS)",
+    "libdmumps-5.5.so": "CeCILL-C (MUMPS; its PORD ordering public domain)",
+    "libmumps_common-5.5.so": "CeCILL-C (MUMPS)",
     "libopenblas.so.0": "BSD-3-Clause (OpenBLAS)",
     "libtinyxml2.so.9": "Zlib (TinyXML-2)",
     "libz.so.1": "Zlib",

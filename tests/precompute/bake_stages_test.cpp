@@ -137,7 +137,7 @@ TEST_P(BakeStages, BlockSolverFindsAlmostEveryMode) {
   EXPECT_LT((phi.transpose() * p.M * phi - Eigen::MatrixXd::Identity(count, count)).cwiseAbs().maxCoeff(), 1e-9);
 }
 
-// The block solver's thick restarts, forced by blocks of 1 (room for k + 16 columns), on the finer
+// The block solver's thick restarts, forced by room for k + 4 columns (blocks of 2), on the finer
 // bar: the pairs still match the dense solve.
 TEST_P(BakeStages, BlockSolverRestartsAndStillMatchesTheDenseSolve) {
   const bool free = GetParam();
@@ -152,7 +152,8 @@ TEST_P(BakeStages, BlockSolverRestartsAndStillMatchesTheDenseSolve) {
   const DirectSolver solver(shifted, *p.layout);
   BlockEigenSettings settings;
   settings.count = 12;
-  settings.blockSize = 1;
+  settings.blockSize = 2;
+  settings.basisColumns = settings.count + 4;
   const Eigen::MatrixXd deflation = free ? p.rigid : Eigen::MatrixXd(p.layout->localDofs(), 0);
   const BlockEigenPairs pairs = blockEigenpairs(solver, p.system.mass, shift, deflation, *p.layout, settings);
   EXPECT_GT(pairs.restarts, 0);
@@ -192,7 +193,7 @@ TEST(BakeStages, DerivativesThroughTheSharedFactorAreTheSame) {
   EXPECT_EQ((own.vectors - reused.vectors).cwiseAbs().maxCoeff(), 0.0);
 }
 
-// -factor_distributed (PETSc's parallel MUMPS instead of a whole factor per rank) solves the same
+// -factor_distributed (PETSc's parallel MUMPS instead of our factors) solves the same
 // systems: its modes and its derivatives of the same modes agree with the default's to round-off.
 TEST(BakeStages, DistributedFactorSolvesTheSameSystems) {
   Problem p(false);
@@ -240,6 +241,24 @@ TEST(BakeStages, SplitFactorSolvesLikeADenseFactor) {
   for (Eigen::Index i = 0; i < n; ++i)
     for (int c = 0; c < 3; ++c) B(i, c) = std::sin(1.0 + 0.37 * (p.layout->rowStart() + i) + c);
   split->solve(B.data(), X.data(), 3);
+  const Eigen::MatrixXd expected = p.K.ldlt().solve(p.dense(B));
+  EXPECT_LT((p.dense(X) - expected).norm(), 1e-10 * expected.norm());
+}
+
+// With no room for an interface (-factor_max_interface 0) every rank factors the whole matrix and
+// solves its share of the columns: the same solutions as a dense factor.
+TEST(BakeStages, WholeFactorPerRankSolvesLikeADenseFactor) {
+  Problem p(false, {16, 3, 4});
+  QV_PETSC(PetscOptionsSetValue(nullptr, "-factor_max_interface", "0"));
+  std::unique_ptr<DirectSolver> solver;
+  EXPECT_NO_THROW(solver = std::make_unique<DirectSolver>(p.system.stiffness, *p.layout));
+  QV_PETSC(PetscOptionsClearValue(nullptr, "-factor_max_interface"));
+  ASSERT_TRUE(solver);
+  const Eigen::Index n = p.layout->localDofs();
+  Eigen::MatrixXd B(n, 5);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (int c = 0; c < 5; ++c) B(i, c) = std::cos(0.3 + 0.11 * (p.layout->rowStart() + i) * (c + 1));
+  const Eigen::MatrixXd X = solver->solve(B, 2);  // rounds of 2 columns: ranks own uneven shares
   const Eigen::MatrixXd expected = p.K.ldlt().solve(p.dense(B));
   EXPECT_LT((p.dense(X) - expected).norm(), 1e-10 * expected.norm());
 }
