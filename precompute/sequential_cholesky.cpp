@@ -77,17 +77,6 @@ std::vector<MUMPS_INT> nestedDissection(const SequentialCholesky::UpperTriangle&
   return perm;
 }
 
-// -log_view rows (PETSc's own MatCholFctrNum and MatMatSolve do not see these calls).
-struct LogEvents {
-  PetscLogEvent order = registerLogEvent("Sequential Cholesky", "SeqCholOrder");
-  PetscLogEvent factor = registerLogEvent("Sequential Cholesky", "SeqCholFactor");
-  PetscLogEvent solve = registerLogEvent("Sequential Cholesky", "SeqCholSolve");
-};
-const LogEvents& events() {
-  static const LogEvents instance;
-  return instance;
-}
-
 } // namespace
 
 static_assert(sizeof(MUMPS_INT) == sizeof(int), "MUMPS built with 64-bit integers");
@@ -166,7 +155,8 @@ SequentialCholesky::SequentialCholesky(UpperTriangle upper, PetscInt schurSize)
     if (set) id.cntl[i - 1] = value;
   }
   {
-    const LogEventScope timed(events().order);
+    static const PetscLogEvent event = registerLogEvent("Sequential Cholesky", "SeqCholOrder");  // a -log_view row
+    const LogEventScope timed(event);
     const PetscInt ordered = n - schurSize;
     if (icntl(id, 7) == 1) {
       m.perm = nestedDissection(m.upper, ordered, ordered % 3 == 0 ? 3 : 1);
@@ -196,7 +186,8 @@ SequentialCholesky::SequentialCholesky(UpperTriangle upper, PetscInt schurSize)
   id.perm_in = nullptr;
   id.job = kFactor;
   {
-    const LogEventScope timed(events().factor);
+    static const PetscLogEvent event = registerLogEvent("Sequential Cholesky", "SeqCholFactor");  // a -log_view row
+    const LogEventScope timed(event);
     dmumps_c(&id);
   }
   if (id.infog[0] < 0) throw std::runtime_error(mumpsError(id, "factorization"));
@@ -236,7 +227,8 @@ void SequentialCholesky::solvePhase(double* columns, PetscInt count, int condens
   id.lredrhs = static_cast<MUMPS_INT>(schurSize_);
   id.job = kSolve;
   {
-    const LogEventScope timed(events().solve);
+    static const PetscLogEvent event = registerLogEvent("Sequential Cholesky", "SeqCholSolve");  // a -log_view row
+    const LogEventScope timed(event);
     dmumps_c(&id);
   }
   if (id.infog[0] < 0) throw std::runtime_error(mumpsError(id, "solve"));

@@ -43,16 +43,6 @@ std::vector<T> gatherInRankOrder(const T* mine, const std::vector<long long>& co
   return all;
 }
 
-// -log_view rows: the interface's part (the subdomains' is SequentialCholesky's).
-struct LogEvents {
-  PetscLogEvent factor = registerLogEvent("Split Cholesky", "SplitSchurFactor");
-  PetscLogEvent solve = registerLogEvent("Split Cholesky", "SplitSchurSolve");
-};
-const LogEvents& events() {
-  static const LogEvents instance;
-  return instance;
-}
-
 } // namespace
 
 std::unique_ptr<SplitCholesky> SplitCholesky::tryCreate(Mat A, MPI_Comm comm, PetscInt maxInterface) {
@@ -171,7 +161,8 @@ std::unique_ptr<SplitCholesky> SplitCholesky::tryCreate(Mat A, MPI_Comm comm, Pe
   // The whole Schur complement on every rank: the interface rows' own entries (each rank's rows,
   // transposed into columns of the symmetric whole), plus every rank's contribution in rank order.
   {
-    const LogEventScope timed(events().factor);
+    static const PetscLogEvent event = registerLogEvent("Split Cholesky", "SplitSchurFactor");  // a -log_view row
+    const LogEventScope timed(event);
     const Eigen::MatrixXd transposed = schurRows.transpose();
     std::vector<long long> rowCounts = counts, contributionCounts(size);
     for (int p = 0; p < size; ++p) {
@@ -221,7 +212,8 @@ void SplitCholesky::solve(const double* B, double* X, PetscInt count) const {
   // g = b_S + the contributions -A_SI A_II^-1 b_I, added in rank order; then x_S on every rank.
   Eigen::MatrixXd xS;
   {
-    const LogEventScope timed(events().solve);
+    static const PetscLogEvent event = registerLogEvent("Split Cholesky", "SplitSchurSolve");  // a -log_view row
+    const LogEventScope timed(event);
     std::vector<long long> borderCounts(size), reducedCounts(size);
     for (int p = 0; p < size; ++p) {
       borderCounts[p] = static_cast<long long>(interfaceCounts_[p]) * count;
