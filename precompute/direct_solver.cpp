@@ -60,8 +60,9 @@ DirectSolver::DirectSolver(Mat A, const DofLayout& layout) : layout_(layout) {
   }
   PetscInt maxInterface = 6000;  // a dense Schur complement of 288 MB per rank
   QV_PETSC(PetscOptionsGetInt(nullptr, "factor_", "-max_interface", &maxInterface, nullptr));
-  if (maxInterface > 46340)  // a dense Schur complement gathered in one MPI call of int counts
-    throw std::runtime_error("-factor_max_interface " + std::to_string(maxInterface) + " exceeds 46340");
+  if (maxInterface < 0 || maxInterface > 46340)  // a dense Schur complement gathered in one MPI call of int counts
+    throw std::runtime_error("-factor_max_interface " + std::to_string(maxInterface) +
+                             ": must lie in 0..46340 (0: every rank factors the whole matrix)");
   split_ = SplitCholesky::tryCreate(A, layout.comm(), maxInterface);
   if (split_) return;
   PetscMat whole;  // several ranks: this rank's copy of the whole matrix, on a communicator of one

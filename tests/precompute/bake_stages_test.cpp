@@ -263,6 +263,23 @@ TEST(BakeStages, WholeFactorPerRankSolvesLikeADenseFactor) {
   EXPECT_LT((p.dense(X) - expected).norm(), 1e-10 * expected.norm());
 }
 
+// -factor_max_interface outside 0..46340 (the dense Schur complement's MPI counts) is refused on
+// every rank, naming the option.
+TEST(BakeStages, MaxInterfaceOutOfRangeIsRefused) {
+  Problem p(false);
+  for (const char* value : {"-1", "46341"}) {
+    QV_PETSC(PetscOptionsSetValue(nullptr, "-factor_max_interface", value));
+    try {
+      DirectSolver solver(p.system.stiffness, *p.layout);
+      ADD_FAILURE() << value << " was accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("-factor_max_interface ") + value + ": must lie in 0..46340"),
+                std::string::npos) << e.what();
+    }
+    QV_PETSC(PetscOptionsClearValue(nullptr, "-factor_max_interface"));
+  }
+}
+
 TEST_P(BakeStages, DerivativesSolveTheDenseSystem) {
   const bool free = GetParam();
   Problem p(free);
