@@ -7,12 +7,12 @@
 
 namespace quiver::rt {
 
-// Solves A x = b for symmetric positive definite A (row-major, n x n; only its upper triangle is
-// read, and it is overwritten by the factor U of A = U^T U). b is overwritten by x. Returns false,
-// leaving A and b spoiled, when A is not positive definite. Right-looking, row by row: the
-// factorisation's and the forward solve's inner loops are axpys along a row, which vectorise
-// without reordering any sum.
-inline bool choleskySolve(double* A, double* b, int n) {
+// Factorises symmetric positive definite A = U^T U in place (row-major, n x n; only its upper
+// triangle is read and overwritten by U). Returns false, leaving A spoiled, when A is not positive
+// definite. Right-looking, row by row: the inner loops are axpys along a row, which vectorise
+// without reordering any sum (choleskyFactorLanes(), cholesky_lanes.h, does the same operations in
+// the same order for a group of matrices).
+inline bool choleskyFactor(double* A, int n) {
   for (int j = 0; j < n; ++j) {
     double* rowJ = A + j * n;
     if (!(rowJ[j] > 0)) return false;
@@ -25,17 +25,30 @@ inline bool choleskySolve(double* A, double* b, int n) {
       for (int k = i; k < n; ++k) rowI[k] -= f * rowJ[k];
     }
   }
+  return true;
+}
+
+// Solves U^T U x = b with the factor U of choleskyFactor(); b is overwritten by x.
+inline void choleskySubstitute(const double* U, double* b, int n) {
   for (int i = 0; i < n; ++i) {  // U^T y = b
-    const double* rowI = A + i * n;
+    const double* rowI = U + i * n;
     b[i] /= rowI[i];
     for (int k = i + 1; k < n; ++k) b[k] -= rowI[k] * b[i];
   }
   for (int i = n - 1; i >= 0; --i) {  // U x = y
-    const double* rowI = A + i * n;
+    const double* rowI = U + i * n;
     double s = b[i];
     for (int k = i + 1; k < n; ++k) s -= rowI[k] * b[k];
     b[i] = s / rowI[i];
   }
+}
+
+// Solves A x = b for symmetric positive definite A (as choleskyFactor(): A is overwritten by its
+// factor); b is overwritten by x. Returns false, leaving A spoiled and b as it was, when A is not
+// positive definite.
+inline bool choleskySolve(double* A, double* b, int n) {
+  if (!choleskyFactor(A, n)) return false;
+  choleskySubstitute(A, b, n);
   return true;
 }
 

@@ -25,6 +25,7 @@ void fillSystem(qv_instance& s, const double* stateJacobian, double c1, double c
 void elasticityAt(qv_instance& s, const double* q, double* energy, double* force) {
   const bool preset = s.work.presetValid && std::memcmp(q, s.work.presetAt, sizeof(double) * s.r) == 0;
   s.work.presetValid = false;  // only ever the first evaluation: the next is elsewhere
+  s.work.presetFactored = s.work.presetFactored && preset;
   if (preset) {
     std::memcpy(force, s.work.presetForce, sizeof(double) * s.r);
     if (energy) *energy = s.work.presetEnergy;
@@ -39,6 +40,12 @@ const double* evaluateForces(qv_instance& s, const double* q) {
 }
 
 QV_HOT qv_step_status solveNewton(qv_instance& s, const double* stateJacobian, double c1, double c2) {
+  const bool factored = s.work.presetFactored && c1 == s.work.presetC1 && c2 == s.work.presetC2;
+  s.work.presetFactored = false;
+  if (factored) {
+    choleskySubstitute(s.work.system, s.work.correction, s.r);
+    return QV_STEP_OK;
+  }
   fillSystem(s, stateJacobian, c1, c2, true);
   // The Cholesky attempt spoils the matrix and the right-hand side, so keep the latter for a second try.
   std::memcpy(s.work.retryRhs, s.work.correction, sizeof(double) * s.r);

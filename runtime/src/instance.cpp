@@ -205,7 +205,7 @@ void qv_instance::solveOwnContacts() {
 qv_step_status qv_instance::finishStep() {
   if (flying()) frame.move(config.time_step);
   const qv_step_status status = quiver::rt::kIntegrators[config.integrator].step(*this);
-  work.presetValid = false;
+  work.presetValid = work.presetFactored = false;
   loads.endStep();
   if (status == QV_STEP_RESET || !healthy()) {
     rest();

@@ -40,6 +40,11 @@ struct StepBuffers {
   double* presetForce = nullptr;
   double presetEnergy = 0;
   bool presetValid = false;
+  // For a fixed Newton step the group also factorises the step's first Newton matrix at that
+  // point, (I + c1 C + c2 (K + J)), into `system`; solveNewton() takes it for the system with
+  // these c1 and c2 right after the preset was taken, instead of filling and factorising its own.
+  bool presetFactored = false;
+  double presetC1 = 0, presetC2 = 0;
 };
 
 // Bytes of the block an instance with `config` needs (64-byte aligned).

@@ -33,14 +33,17 @@ public:
 
   // The same for up to kLanes states at once (reduced_polynomial_lanes.cpp): each coefficient is
   // read once for all of them and multiplies a vector of kLanes values, one per state: the work is
-  // bound by arithmetic, not by streaming the coefficients from L2 as one state's is. Entry i of q, energy, force and
-  // stiffness belongs to state i < count (none may be null). The sums run in another order than
-  // evaluate()'s, so results agree with it to rounding, not bit for bit. `scratch`:
-  // laneScratchSize(r) doubles, 64-byte aligned.
+  // bound by arithmetic, not by streaming the coefficients from L2 as one state's is. Entry i of q,
+  // energy and force belongs to state i < count (none may be null); `stiffness` receives the K(q)
+  // of all kLanes lanes (unused lanes: at q = 0), upper triangles packed row by row and interleaved
+  // by lane: K_ab of state l at stiffness[p * kLanes + l], p the pair (a <= b) in row order
+  // (r(r+1)/2 x kLanes doubles). The sums run in another order than evaluate()'s, so results
+  // agree with it to rounding, not bit for bit. `scratch`: laneScratchSize(r) doubles, 64-byte
+  // aligned.
   static constexpr int kLanes = 8;
   static size_t laneScratchSize(int r);
-  void evaluateLanes(const double* const* q, int count, double* energy, double* const* force,
-                     double* const* stiffness, double* scratch) const;
+  void evaluateLanes(const double* const* q, int count, double* energy, double* const* force, double* stiffness,
+                     double* scratch) const;
 
   int r() const { return r_; }
   bool single() const { return q32_ != nullptr; }

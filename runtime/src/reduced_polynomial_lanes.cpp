@@ -105,8 +105,8 @@ size_t ReducedPolynomial::laneScratchSize(int r) {
   return (monomialCount2(r) * 3 + 2 * static_cast<size_t>(r) + 1) * L;
 }
 
-void ReducedPolynomial::evaluateLanes(const double* const* q, int count, double* energy, double* const* force,
-                                      double* const* stiffness, double* scratch) const {
+QV_HOT void ReducedPolynomial::evaluateLanes(const double* const* q, int count, double* energy, double* const* force,
+                                             double* stiffness, double* scratch) const {
   const int r = r_;
   const size_t P = pairs_;
   double* x = scratch;   // [pair][lane]: w_kl q_k q_l
@@ -119,6 +119,7 @@ void ReducedPolynomial::evaluateLanes(const double* const* q, int count, double*
     for (int l = 0; l < L; ++l) ql[k * L + l] = l < count ? q[l][k] : 0.0;
   for (int k = 0, s = 0; k < r; ++k)
     for (int m = k; m < r; ++m, ++s)
+#pragma omp simd
       for (int l = 0; l < L; ++l) x[s * L + l] = (k == m ? 0.5 : 1.0) * ql[k * L + l] * ql[m * L + l];
   if (q32_)
     packedSymmetricProductLanes(q32_, rowStart_, rowOffset_, P, x, y4);
@@ -127,22 +128,14 @@ void ReducedPolynomial::evaluateLanes(const double* const* q, int count, double*
   sumOfRowsLanes(t_, r, P, ql, y3);
   std::memset(Rq, 0, sizeof(double) * r * L);
   std::memset(e, 0, sizeof(double) * L);
-  // K(q) state by state: its upper triangle row by row, then mirrored within the state's own
-  // matrix (writing both halves pair by pair would scatter stores over all the group's matrices).
-  for (int l = 0; l < count; ++l) {
-    double* K = stiffness[l];
-    for (int a = 0, p = 0; a < r; ++a)
-      for (int b = a; b < r; ++b, ++p) K[a * r + b] = k2_[p] + y3[p * L + l] + y4[p * L + l];
-    for (int a = 0; a < r; ++a)
-      for (int b = a + 1; b < r; ++b) K[b * r + a] = K[a * r + b];
-  }
-  // The force and energy as evaluate() assembles them, pair by pair, SIMD across the states.
+  // K, the force and the energy as evaluate() assembles them, pair by pair, SIMD across the states.
   for (int a = 0, p = 0; a < r; ++a)
     for (int b = a; b < r; ++b, ++p) {
       const double k2 = k2_[p], weight = a == b ? 1.0 : 2.0;
 #pragma omp simd
       for (int l = 0; l < L; ++l) {
         const double s3 = y3[p * L + l], s4 = y4[p * L + l];
+        stiffness[p * L + l] = k2 + s3 + s4;
         const double f = k2 + s3 / 2 + s4 / 3, h = k2 / 2 + s3 / 6 + s4 / 12;
         const double qa = ql[a * L + l], qb = ql[b * L + l];
         Rq[a * L + l] += f * qb;

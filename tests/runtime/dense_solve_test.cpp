@@ -3,7 +3,9 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <random>
+#include <vector>
 
+#include "runtime/src/cholesky_lanes.h"
 #include "runtime/src/dense_solve.h"
 
 using namespace quiver::rt;
@@ -38,4 +40,50 @@ TEST(DenseSolve, CholeskyAndPivotingLuAgainstEigen) {
   Eigen::Vector3d rhs(1, 2, 3);
   int pivot[3];
   EXPECT_FALSE(luSolve(singular.data(), rhs.data(), pivot, 3));
+}
+
+TEST(DenseSolve, CholeskyLanesFactoriseEachLaneAsAloneAndKeepABadLaneToItself) {
+  constexpr int L = kCholeskyLanes;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> n(0, 1);
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  for (int size : {1, 7, 30}) {
+    std::vector<Eigen::MatrixXd> spd(L);
+    for (int l = 0; l < L; ++l) {
+      Eigen::MatrixXd B(size, size);
+      for (auto& x : B.reshaped()) x = n(rng);
+      spd[l] = std::pow(10.0, l - 4) * (B * B.transpose() + 0.1 * Eigen::MatrixXd::Identity(size, size));
+    }
+    Eigen::MatrixXd indefinite = spd[5];
+    indefinite(size - 1, size - 1) = -1;  // fails at the last pivot: every row before it is worked on
+    const size_t packed = packedUpperIndex(size, size, size);
+    auto interleave = [&](bool bad) {
+      std::vector<double> A(packed * L);
+      for (int l = 0; l < L; ++l)
+        for (int i = 0; i < size; ++i)
+          for (int j = i; j < size; ++j) A[packedUpperIndex(size, i, j) * L + l] = (bad && l == 5 ? indefinite : spd[l])(i, j);
+      return A;
+    };
+    std::vector<double> good = interleave(false), bad = interleave(true);
+    bool okGood[L], okBad[L];
+    choleskyFactorLanes(good.data(), size, okGood);
+    choleskyFactorLanes(bad.data(), size, okBad);
+    for (int l = 0; l < L; ++l) {
+      EXPECT_TRUE(okGood[l]) << size << " lane " << l;
+      EXPECT_EQ(okBad[l], l != 5) << size << " lane " << l;
+      RowMajor U = RowMajor::Zero(size, size), alone = spd[l];
+      for (int i = 0; i < size; ++i)
+        for (int j = i; j < size; ++j) {
+          U(i, j) = good[packedUpperIndex(size, i, j) * L + l];
+          if (l != 5) {
+            EXPECT_EQ(bad[packedUpperIndex(size, i, j) * L + l], U(i, j)) << "the bad lane leaked into lane " << l;
+          }
+        }
+      // Against the product, and against the one-matrix factorisation (the same operations; compiled
+      // for other instruction sets, so to rounding).
+      EXPECT_LT((U.transpose() * U - spd[l]).norm(), 1e-13 * spd[l].norm()) << size << " lane " << l;
+      ASSERT_TRUE(choleskyFactor(alone.data(), size));
+      EXPECT_LT((alone.triangularView<Eigen::Upper>().toDenseMatrix() - U).norm(), 1e-13 * U.norm()) << size << " lane " << l;
+    }
+  }
 }

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <memory>
 #include <random>
 #include <thread>
@@ -33,10 +34,13 @@ struct Crowd {
   std::vector<qv_instance*> instances;
   int tip = 0, r = 0;
 
-  Crowd(const quiver::test::TestModel& m, const qv_instance_config& config, int count) : tip(m.tipVertex()), r(m.info.r) {
+  Crowd(const quiver::test::TestModel& m, const qv_instance_config& config, int count)
+      : Crowd(m, [&](int) { return config; }, count) {}
+  Crowd(const quiver::test::TestModel& m, const std::function<qv_instance_config(int)>& configOf, int count)
+      : tip(m.tipVertex()), r(m.info.r) {
     const double g[3] = {0, 0, -9.81};
     for (int i = 0; i < count; ++i) {
-      owned.push_back(std::make_unique<quiver::test::Instance>(m.model, config));
+      owned.push_back(std::make_unique<quiver::test::Instance>(m.model, configOf(i)));
       instances.push_back(owned.back()->s);
       qv_instance_set_gravity(instances.back(), g);
     }
@@ -66,6 +70,17 @@ void runOnThreads(void*, qv_job_function job, void* data, int count) {
   for (auto& t : threads) t.join();
 }
 
+// evaluateLanes() with each state's K unpacked from the group's packed lanes into its r x r matrix.
+void evaluateGroup(const quiver::rt::ReducedPolynomial& poly, const double* const* q, int count, double* energy,
+                   double* const* force, double* const* K, double* scratch) {
+  const int r = poly.r(), L = quiver::rt::ReducedPolynomial::kLanes;
+  std::vector<double> lanes(static_cast<size_t>(r) * (r + 1) / 2 * L);
+  poly.evaluateLanes(q, count, energy, force, lanes.data(), scratch);
+  for (int l = 0; l < count; ++l)
+    for (int a = 0, p = 0; a < r; ++a)
+      for (int b = a; b < r; ++b, ++p) K[l][a * r + b] = K[l][b * r + a] = lanes[p * L + l];
+}
+
 } // namespace
 
 TEST(StepMany, GroupEvaluationMatchesTheFullSpaceProjection) {
@@ -90,7 +105,7 @@ TEST(StepMany, GroupEvaluationMatchesTheFullSpaceProjection) {
     forces[i] = force[i].data();
     stiffnesses[i] = K[i].data();
   }
-  poly.evaluateLanes(at.data(), count, energy, forces.data(), stiffnesses.data(), aligned);
+  evaluateGroup(poly, at.data(), count, energy, forces.data(), stiffnesses.data(), aligned);
   for (int i = 0; i < count; ++i) {
     Eigen::VectorXd exactForce;
     Eigen::MatrixXd exactK;
@@ -127,7 +142,7 @@ TEST(StepMany, GroupEvaluationAgreesWithOneStateForEveryGroupSizeAndPrecision) {
         for (double& x : q[l]) x = n(rng);
         at[l] = q[l].data(), fp[l] = f[l].data(), kp[l] = K[l].data();
       }
-      model->polynomial.evaluateLanes(at.data(), count, energy, fp.data(), kp.data(), aligned);
+      evaluateGroup(model->polynomial, at.data(), count, energy, fp.data(), kp.data(), aligned);
       for (int l = 0; l < count; ++l) {
         std::vector<double> f1(r), K1(r * r);
         double e1 = 0;
@@ -179,6 +194,58 @@ TEST(StepMany, StatesAgreeWithSteppingOneByOne) {
     EXPECT_LT(worst, 1e-9 * largest) << qv_solver_name(solver);
     EXPECT_GT(worst, 0.0) << qv_solver_name(solver) << ": every state bit-identical, so no group evaluation was used";
     EXPECT_GT(largest, 1e-3);
+  }
+}
+
+TEST(StepMany, NewtonMatricesFactorisedInGroupsAgreeWithEachInstanceOwn) {
+  // The group factorises each fixed Newton step's first matrix I + c1 C + c2 (K + J): here with
+  // time steps, Rayleigh damping and held tips (J) that differ from lane to lane, and a second
+  // Newton iteration that must factorise its own matrix at its own point.
+  quiver::test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  for (int iterations : {1, 2}) {
+    const auto configOf = [&](int i) {
+      qv_instance_config config;
+      qv_instance_config_init(&config, m.model);
+      config.solver = QV_SOLVER_NEWTON;
+      config.newton_iterations = iterations;
+      config.time_step *= 1 + 0.25 * (i % 3);
+      config.rayleigh_alpha = 0.5 * (i % 2);
+      config.rayleigh_beta = 0.004 * (i % 4);
+      return config;
+    };
+    const int count = 13;
+    Crowd batched(m, configOf, count), single(m, configOf, count);
+    for (Crowd* crowd : {&batched, &single})
+      for (int i = 0; i < count; i += 3) {
+        const double target[3] = {1.0, 0.005 * i, -0.02};
+        ASSERT_EQ(qv_instance_set_constraint(crowd->instances[i], 0, &crowd->tip, 1, target, 500), QV_OK);
+      }
+    size_t bytes = 0;
+    Scratch scratch = scratchFor(m.model, 1, bytes);
+    std::vector<qv_step_status> statuses(count);
+    int indefinite = 0;
+    for (int step = 0; step < 90; ++step) {
+      batched.load(step);
+      single.load(step);
+      ASSERT_EQ(qv_instances_step(batched.instances.data(), count, nullptr, scratch.get(), bytes, statuses.data()), QV_OK);
+      for (int i = 0; i < count; ++i) {
+        const qv_step_status alone = qv_instance_step(single.instances[i]);
+        EXPECT_EQ(statuses[i], alone) << "instance " << i << " step " << step;
+        indefinite += alone == QV_STEP_INDEFINITE;
+      }
+    }
+    double largest = 0, worst = 0;
+    for (int i = 0; i < count; ++i) {
+      const std::vector<double> a = batched.state(i), b = single.state(i);
+      for (int k = 0; k < m.info.r; ++k) {
+        largest = std::max(largest, std::abs(b[k]));
+        worst = std::max(worst, std::abs(a[k] - b[k]));
+      }
+    }
+    EXPECT_LT(worst, 1e-9 * largest) << iterations << " Newton iterations";
+    EXPECT_GT(largest, 1e-3);
+    std::printf("%d Newton iterations: %d of %d steps indefinite\n", iterations, indefinite, 90 * count);
   }
 }
 

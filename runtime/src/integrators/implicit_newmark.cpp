@@ -36,7 +36,7 @@ qv_step_status minimizing(qv_instance& s) {
 
 qv_step_status stepImplicitNewmark(qv_instance& s) {
   if (s.config.solver == QV_SOLVER_MINIMIZE) return minimizing(s);
-  const double h = s.config.time_step, beta = 0.25, gamma = 0.5;
+  const double h = s.config.time_step, beta = kNewmarkBeta, gamma = kNewmarkGamma;
   const int r = s.r;
   double *q = s.q, *v = s.v, *a = s.a;
   std::memcpy(s.end.a, a, sizeof(double) * r);
@@ -49,7 +49,9 @@ qv_step_status stepImplicitNewmark(qv_instance& s) {
     const double* J = evaluateForces(s, s.end.q);
     for (int i = 0; i < r; ++i)
       s.work.correction[i] = -(s.end.a[i] + dampingForce(s, i, s.end.v) + s.work.force[i] - s.loads.external(i));
-    const qv_step_status solved = solveNewton(s, J, gamma * h, beta * h * h);
+    double c1, c2;
+    newmarkNewtonScales(s, c1, c2);
+    const qv_step_status solved = solveNewton(s, J, c1, c2);
     if (solved == QV_STEP_RESET) return solved;
     if (solved == QV_STEP_INDEFINITE) status = solved;
     for (int i = 0; i < r; ++i) s.end.a[i] += s.work.correction[i];

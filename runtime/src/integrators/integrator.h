@@ -30,6 +30,14 @@ inline double newmarkGuess(const qv_instance& s, int i) {
   const double h = s.config.time_step;
   return s.q[i] + h * s.v[i] + 0.5 * h * h * s.a[i];
 }
+// Implicit Newmark's parameters (the trapezoidal rule), and the scales of its fixed Newton step's
+// system (I + c1 C + c2 (K + J)) x = rhs.
+constexpr double kNewmarkBeta = 0.25, kNewmarkGamma = 0.5;
+inline void newmarkNewtonScales(const qv_instance& s, double& c1, double& c2) {
+  const double h = s.config.time_step;
+  c1 = kNewmarkGamma * h;
+  c2 = kNewmarkBeta * h * h;
+}
 qv_step_status stepBackwardEuler(qv_instance& s);
 qv_step_status stepCentralDifferences(qv_instance& s);
 
