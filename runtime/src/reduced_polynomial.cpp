@@ -39,37 +39,50 @@ size_t packedCount(size_t pairs) {
 }
 
 // y[s] += Q[p][s] x[p] for s > p and y[p] += sum_s Q[p][s] x[s]: one pass over row p of the upper
-// triangle does both halves of the symmetric product (the stored diagonal is halved). Rows come
-// four at a time: rows of one 8-aligned group start at the same column and have the same length,
-// so one sweep updates y once for four rows and reads x once.
+// triangle does both halves of the symmetric product (the stored diagonal is halved). The rows of
+// one 8-aligned group start at the same column and have the same length, so one sweep updates y
+// once for all eight and reads x once: per coefficient, one multiply-add into its row's dot
+// product and one into y, with y's load and store shared by eight of them.
 template <class C>
 QV_HOT void packedSymmetricProduct(const C* Q, const size_t* rowStart, const size_t* rowOffset, size_t n,
                                    const double* x, double* y) {
+  constexpr size_t G = 8;
   for (size_t s = 0; s < n; ++s) y[s] = 0;
   size_t p = 0;
-  for (; p + 4 <= n; p += 4) {
+  for (; p + G <= n; p += G) {
     const size_t start = rowStart[p];
-    const C* r0 = Q + rowOffset[p] - start;
-    const C* r1 = Q + rowOffset[p + 1] - start;
-    const C* r2 = Q + rowOffset[p + 2] - start;
-    const C* r3 = Q + rowOffset[p + 3] - start;
-    const double x0 = x[p], x1 = x[p + 1], x2 = x[p + 2], x3 = x[p + 3];
-    double d0 = 0, d1 = 0, d2 = 0, d3 = 0;
-#pragma omp simd reduction(+ : d0, d1, d2, d3)
+    const C* row[G];
+    double xp[G];
+    for (size_t g = 0; g < G; ++g) {
+      row[g] = Q + rowOffset[p + g] - start;
+      xp[g] = x[p + g];
+    }
+    double d0 = 0, d1 = 0, d2 = 0, d3 = 0, d4 = 0, d5 = 0, d6 = 0, d7 = 0;
+#pragma omp simd reduction(+ : d0, d1, d2, d3, d4, d5, d6, d7)
     for (size_t s = start; s < n; ++s) {
-      const double c0 = static_cast<double>(r0[s]), c1 = static_cast<double>(r1[s]);
-      const double c2 = static_cast<double>(r2[s]), c3 = static_cast<double>(r3[s]);
+      const double c0 = static_cast<double>(row[0][s]), c1 = static_cast<double>(row[1][s]);
+      const double c2 = static_cast<double>(row[2][s]), c3 = static_cast<double>(row[3][s]);
+      const double c4 = static_cast<double>(row[4][s]), c5 = static_cast<double>(row[5][s]);
+      const double c6 = static_cast<double>(row[6][s]), c7 = static_cast<double>(row[7][s]);
       const double xs = x[s];
       d0 += c0 * xs;
       d1 += c1 * xs;
       d2 += c2 * xs;
       d3 += c3 * xs;
-      y[s] += c0 * x0 + c1 * x1 + c2 * x2 + c3 * x3;
+      d4 += c4 * xs;
+      d5 += c5 * xs;
+      d6 += c6 * xs;
+      d7 += c7 * xs;
+      y[s] += (c0 * xp[0] + c1 * xp[1] + c2 * xp[2] + c3 * xp[3]) + (c4 * xp[4] + c5 * xp[5] + c6 * xp[6] + c7 * xp[7]);
     }
     y[p] += d0;
     y[p + 1] += d1;
     y[p + 2] += d2;
     y[p + 3] += d3;
+    y[p + 4] += d4;
+    y[p + 5] += d5;
+    y[p + 6] += d6;
+    y[p + 7] += d7;
   }
   for (; p < n; ++p) {
     const C* row = Q + rowOffset[p] - rowStart[p];
