@@ -203,8 +203,15 @@ void qv_instance::solveOwnContacts() {
 }
 
 qv_step_status qv_instance::finishStep() {
+  moveFrame();
+  return endStep(quiver::rt::kIntegrators[config.integrator].step(*this));
+}
+
+void qv_instance::moveFrame() {
   if (flying()) frame.move(config.time_step);
-  const qv_step_status status = quiver::rt::kIntegrators[config.integrator].step(*this);
+}
+
+qv_step_status qv_instance::endStep(qv_step_status status) {
   work.presetValid = work.presetFactored = false;
   loads.endStep();
   if (status == QV_STEP_RESET || !healthy()) {

@@ -95,7 +95,9 @@ struct qv_instance {
   void beginStep();
   void solveOwnContacts();
   void beginOwnStep();  // beginStep() and, in flight, solveOwnContacts(): a step outside a world, up to finishStep()
-  qv_step_status finishStep();
+  qv_step_status finishStep();  // moveFrame(), the integrator's step, endStep()
+  void moveFrame();              // in flight, the frame's move over the step, before q's
+  qv_step_status endStep(qv_step_status status);  // the per-step loads are spent; a blown-up state resets
   // The snapshot: r, then q, v, a, E(q) and the energy slack, then in flight the frame (position,
   // orientation, velocity, angular momentum, last body omega), as doubles.
   size_t snapshotSize() const { return sizeof(double) * (3 * static_cast<size_t>(r) + 3 + (flying() ? 16 : 0)); }

@@ -1,6 +1,7 @@
 #include "step_many.h"
 
 #include <algorithm>
+#include <cstring>
 
 #include "cholesky_lanes.h"
 #include "integrators/integrator.h"
@@ -41,7 +42,7 @@ void factoriseGroup(qv_instance* const* group, int count, double* A) {
   const int r = group[0]->r;
   double scaleK[kLanes], scaleJ[kLanes], diagonal[kLanes], c1[kLanes], c2[kLanes];
   const double* J[kLanes];
-  bool constrained = false;
+  bool constrained = false, any = false;
   for (int l = 0; l < kLanes; ++l) {
     const qv_instance& s = *group[l < count ? l : 0];
     const bool factorised = l < count && factorisedInGroup(s);
@@ -51,7 +52,9 @@ void factoriseGroup(qv_instance* const* group, int count, double* A) {
     diagonal[l] = factorised ? 1.0 + c1[l] * s.config.rayleigh_alpha : 1.0;
     J[l] = s.loads.constraintK;  // zero while no constraint is active
     constrained = constrained || (factorised && s.loads.constrained);
+    any = any || factorised;
   }
+  if (!any) return;
   for (int a = 0, p = 0; a < r; ++a)
     for (int b = a; b < r; ++b, ++p) {
       double* x = A + p * kLanes;
@@ -73,36 +76,90 @@ void factoriseGroup(qv_instance* const* group, int count, double* A) {
   }
 }
 
-void stepGroup(qv_instance* const* group, const int* index, int count, double* scratch, qv_step_status* statuses) {
-  const int r = group[0]->r;
+// Evaluates the members' polynomials together at their presetAt points and leaves each one's
+// preset for its step's next evaluation there: R(q) and E(q), K(q) in its `stiffness`; returns
+// the group's K packed by lane (evaluateLanes()) in `scratch`.
+double* evaluateTogether(qv_instance* const* members, int count, double* scratch) {
+  const int r = members[0]->r;
   double* stiffnessLanes = scratch;  // [pair][lane]
-  double* polynomialScratch = scratch + pairs(r) * kLanes;
   const double* at[kLanes] = {};
   double* force[kLanes] = {};
   double* stiffness[kLanes] = {};
   double energy[kLanes] = {};
-  bool factorise = false;
+  for (int l = 0; l < count; ++l) {
+    at[l] = members[l]->work.presetAt;
+    force[l] = members[l]->work.presetForce;
+    stiffness[l] = members[l]->work.stiffness;
+  }
+  members[0]->model->polynomial.evaluateLanes(at, count, energy, force, stiffnessLanes, scratch + pairs(r) * kLanes);
+  unpackUpper(stiffnessLanes, r, count, stiffness);
+  for (int l = 0; l < count; ++l) {  // the lower half, within each member's own matrix
+    for (int a = 0; a < r; ++a)
+      for (int b = a + 1; b < r; ++b) stiffness[l][b * r + a] = stiffness[l][a * r + b];
+    members[l]->work.presetEnergy = energy[l];
+    members[l]->work.presetValid = true;
+  }
+  return stiffnessLanes;
+}
+
+// Fixed Newton steps, up to kLanes: one evaluation each, at the first guess, and its Newton
+// matrix, both together.
+void stepNewtonGroup(qv_instance* const* group, const int* index, int count, double* scratch,
+                     qv_step_status* statuses) {
   for (int l = 0; l < count; ++l) {
     qv_instance& s = *group[l];
     s.beginOwnStep();
     for (int i = 0; i < s.r; ++i) s.work.presetAt[i] = newmarkGuess(s, i);
-    at[l] = s.work.presetAt;
-    force[l] = s.work.presetForce;
-    stiffness[l] = s.work.stiffness;
-    factorise = factorise || factorisedInGroup(s);
   }
-  group[0]->model->polynomial.evaluateLanes(at, count, energy, force, stiffnessLanes, polynomialScratch);
-  unpackUpper(stiffnessLanes, r, count, stiffness);
-  for (int l = 0; l < count; ++l)  // the lower half, within each member's own matrix
-    for (int a = 0; a < r; ++a)
-      for (int b = a + 1; b < r; ++b) stiffness[l][b * r + a] = stiffness[l][a * r + b];
-  if (factorise) factoriseGroup(group, count, stiffnessLanes);
+  factoriseGroup(group, count, evaluateTogether(group, count, scratch));
   for (int l = 0; l < count; ++l) {
-    qv_instance& s = *group[l];
-    s.work.presetEnergy = energy[l];
-    s.work.presetValid = true;
-    const qv_step_status status = s.finishStep();
+    const qv_step_status status = group[l]->finishStep();
     if (statuses) statuses[index[l]] = status;
+  }
+}
+
+// Minimising steps in lock step: up to kLanes under way, each round evaluates every one's pending
+// point together and resumes them; a finished step's lane goes to the next instance that
+// `next(i)` names (-1: none). Every evaluation of these steps is a group's, so each one's bits do
+// not depend on which others share its rounds.
+template <class Next>
+void stepMinimizingTogether(qv_instance* const* instances, Next next, double* scratch, qv_step_status* statuses) {
+  qv_instance* member[kLanes];
+  int index[kLanes];
+  MinimizeTask task[kLanes];
+  StepPredictor predictor[kLanes];
+  int active = 0, cursor = next(-1);
+  const auto admit = [&](int lane) {
+    qv_instance& s = *instances[cursor];
+    s.beginOwnStep();
+    s.moveFrame();
+    predictor[lane] = beginNewmarkMinimization(s);
+    task[lane].begin(s, predictor[lane]);
+    member[lane] = &s;
+    index[lane] = cursor;
+    cursor = next(cursor);
+  };
+  while (active < kLanes && cursor >= 0) admit(active++);
+  while (active > 0) {
+    for (int l = 0; l < active; ++l)
+      std::memcpy(member[l]->work.presetAt, task[l].pending(), sizeof(double) * member[l]->r);
+    evaluateTogether(member, active, scratch);
+    for (int l = 0; l < active; ++l) task[l].resume();
+    for (int l = 0; l < active;) {
+      if (task[l].pending()) {
+        ++l;
+        continue;
+      }
+      qv_instance& s = *member[l];
+      const qv_step_status status = s.endStep(endNewmarkMinimization(s, predictor[l], task[l].status()));
+      if (statuses) statuses[index[l]] = status;
+      if (cursor >= 0) {
+        admit(l++);
+      } else {  // the last lane's step moves here
+        --active;
+        member[l] = member[active], index[l] = index[active], task[l] = task[active], predictor[l] = predictor[active];
+      }
+    }
   }
 }
 
@@ -116,32 +173,38 @@ size_t stepManyScratchPerJob(const qv_model& model) {
 
 namespace {
 
-// Steps instances [first, last): groups of the groupable ones in order, the others alone.
-void stepRange(qv_instance* const* instances, int first, int last, void* scratch, qv_step_status* statuses) {
+bool minimizing(const qv_instance& s) { return s.config.solver == QV_SOLVER_MINIMIZE; }
+
+// Steps instances [first, last). The groupable ones are stepped together: fixed Newton steps in
+// groups of kLanes in order, minimising steps in lock step; the others alone. So that the same
+// instances are evaluated together whatever the jobs, a groupable instance that would be alone in
+// the last group of kLanes is stepped alone (the one-state evaluation is the faster).
+void stepRange(qv_instance* const* instances, int first, int last, double* scratch, qv_step_status* statuses) {
+  int groupableCount = 0, lone = -1;
+  for (int i = first; i < last; ++i)
+    if (groupable(*instances[i]) && groupableCount++ % kLanes == 0) lone = i;
+  if (groupableCount % kLanes != 1) lone = -1;
   qv_instance* group[kLanes];
   int index[kLanes];
   int count = 0;
-  auto flush = [&] {
-    if (count > 1) {
-      stepGroup(group, index, count, static_cast<double*>(scratch), statuses);
-    } else if (count == 1) {  // alone, the one-state evaluation is the faster
-      const qv_step_status status = group[0]->step();
-      if (statuses) statuses[index[0]] = status;
-    }
-    count = 0;
-  };
   for (int i = first; i < last; ++i) {
     qv_instance& s = *instances[i];
-    if (!groupable(s)) {
+    if (!groupable(s) || i == lone) {
       const qv_step_status status = s.step();
       if (statuses) statuses[i] = status;
-      continue;
+    } else if (!minimizing(s)) {
+      group[count] = &s;
+      index[count++] = i;
+      if (count == kLanes) stepNewtonGroup(group, index, count, scratch, statuses), count = 0;
     }
-    group[count] = &s;
-    index[count++] = i;
-    if (count == kLanes) flush();
   }
-  flush();
+  if (count > 0) stepNewtonGroup(group, index, count, scratch, statuses);
+  const auto next = [&](int i) {
+    for (i = i < first ? first : i + 1; i < last; ++i)
+      if (i != lone && groupable(*instances[i]) && minimizing(*instances[i])) return i;
+    return -1;
+  };
+  stepMinimizingTogether(instances, next, scratch, statuses);
 }
 
 struct Work {
@@ -160,7 +223,7 @@ void runJob(void* data, int job) {
   const long long groups = (w.count + kLanes - 1) / kLanes;
   const auto bound = [&](int j) { return static_cast<int>(std::min<long long>(w.count, groups * j / w.jobs * kLanes)); };
   const size_t perJob = stepManyScratchPerJob(*w.instances[0]->model);
-  stepRange(w.instances, bound(job), bound(job + 1), w.scratch + perJob * job, w.statuses);
+  stepRange(w.instances, bound(job), bound(job + 1), reinterpret_cast<double*>(w.scratch + perJob * job), w.statuses);
 }
 
 } // namespace

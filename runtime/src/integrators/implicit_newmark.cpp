@@ -9,33 +9,32 @@
 
 namespace quiver::rt {
 
-namespace {
-
-// The end of the step as the minimum of its incremental potential, with Newmark's own acceleration
-// a' = 4/h^2 (x - qt) (the equations of motion's at convergence; bounded by the potential when the
-// iteration cap comes first), or none where the step was held back.
-qv_step_status minimizing(qv_instance& s) {
+StepPredictor beginNewmarkMinimization(qv_instance& s) {
   const double h = s.config.time_step;
   const int r = s.r;
-  double *q = s.q, *v = s.v, *a = s.a;
+  const double *q = s.q, *v = s.v, *a = s.a;
   for (int i = 0; i < r; ++i) {
     s.work.predictor[i] = q[i] + h * v[i] + 0.25 * h * h * a[i];
     s.work.predictorVelocity[i] = v[i] + 0.5 * h * a[i];
     s.end.q[i] = newmarkGuess(s, i);
   }
-  const double w = 4 / (h * h);
-  const qv_step_status status = minimizeStep(s, StepPredictor{w, 2 / h, h});
-  for (int i = 0; i < r; ++i) s.end.a[i] = s.lastStep.held_back ? 0.0 : w * (s.end.q[i] - s.work.predictor[i]);
-  std::memcpy(q, s.end.q, sizeof(double) * r);
-  std::memcpy(v, s.end.v, sizeof(double) * r);
-  std::memcpy(a, s.end.a, sizeof(double) * r);
+  return StepPredictor{4 / (h * h), 2 / h, h};
+}
+
+qv_step_status endNewmarkMinimization(qv_instance& s, const StepPredictor& p, qv_step_status status) {
+  const int r = s.r;
+  for (int i = 0; i < r; ++i) s.end.a[i] = s.lastStep.held_back ? 0.0 : p.w * (s.end.q[i] - s.work.predictor[i]);
+  std::memcpy(s.q, s.end.q, sizeof(double) * r);
+  std::memcpy(s.v, s.end.v, sizeof(double) * r);
+  std::memcpy(s.a, s.end.a, sizeof(double) * r);
   return status;
 }
 
-} // namespace
-
 qv_step_status stepImplicitNewmark(qv_instance& s) {
-  if (s.config.solver == QV_SOLVER_MINIMIZE) return minimizing(s);
+  if (s.config.solver == QV_SOLVER_MINIMIZE) {
+    const StepPredictor p = beginNewmarkMinimization(s);
+    return endNewmarkMinimization(s, p, minimizeStep(s, p));
+  }
   const double h = s.config.time_step, beta = kNewmarkBeta, gamma = kNewmarkGamma;
   const int r = s.r;
   double *q = s.q, *v = s.v, *a = s.a;

@@ -19,21 +19,16 @@ double dot(const double* a, const double* b, int n) {
 
 double norm(const double* a, int n) { return std::sqrt(dot(a, a, n)); }
 
-// Phi at one iterate, the force scale of its convergence test and the state forces' Jacobian.
-struct Point {
-  double phi = 0, scale = 0;
-  const double* jacobian = nullptr;
-};
-
 class Minimizer {
 public:
-  Minimizer(qv_instance& s, const StepPredictor& p, const double* qt, const double* v0, double* velocity)
-      : s_(s), p_(p), qt_(qt), v0_(v0), velocity_(velocity), r_(s.r), m_(*s.model) {}
+  // qt in s.work.predictor, v0 in s.work.predictorVelocity; v(x) into s.end.v.
+  Minimizer(qv_instance& s, const StepPredictor& p)
+      : s_(s), p_(p), qt_(s.work.predictor), v0_(s.work.predictorVelocity), velocity_(s.end.v), r_(s.r), m_(*s.model) {}
 
   // Evaluates Phi at x and leaves its gradient in s.work.gradient, R + S' in s.work.force, K(x) in
   // s.work.stiffness, v(x) in `velocity` and E(x) in `elastic`.
-  Point evaluate(const double* x, double* elastic) {
-    Point pt;
+  PhiPoint evaluate(const double* x, double* elastic) {
+    PhiPoint pt;
     double E = 0, S = 0;
     elasticityAt(s_, x, &E, s_.work.force);
     pt.jacobian = s_.loads.addStateForces(x, s_.work.force, &S);
@@ -144,70 +139,113 @@ double restDampingForce(const qv_instance& s, int i, const double* v) {
   return c;
 }
 
-qv_step_status minimizeStep(qv_instance& s, const StepPredictor& p) {
-  const int r = s.r;
+void MinimizeTask::begin(qv_instance& s, const StepPredictor& p) {
+  s_ = &s;
+  p_ = p;
   // What the step may end with: what it began with, what earlier steps' discretisation lost and
   // may win back (the trapezoidal rule trades a little energy back and forth on nonlinear models),
-  // less what damping dissipates in it (below).
+  // less what damping dissipates in it (finish()).
   // Loads that changed since the last step start the budget anew: what the discretisation lost
   // under the old loads is not owed under the new ones.
   if (s.loads.changedSinceLastStep()) s.energySlack = 0;
-  double budget = stepEnergy(s, s.q, s.v, s.elasticEnergyAtState) + s.energySlack;
-  const double* qt = s.work.predictor;
-  const double* v0 = s.work.predictorVelocity;
-  double* x = s.end.q;
-  double* velocity = s.end.v;
-  Minimizer minimizer(s, p, qt, v0, velocity);
-  double elastic = 0;
-  Point at = minimizer.evaluate(x, &elastic);
-  qv_step_status status = QV_STEP_OK;
-  qv_step_report& report = s.lastStep;
-  for (int it = 0;; ++it) {
-    const double gradient = norm(s.work.gradient, r);
-    if (!std::isfinite(gradient) || !std::isfinite(at.phi)) return QV_STEP_RESET;  // non-finite input
-    report.gradient = gradient / (at.scale + 1e-300);
-    if (gradient <= s.config.newton_tolerance * at.scale) {
-      report.converged = 1;
-      break;
+  budget_ = stepEnergy(s, s.q, s.v, s.elasticEnergyAtState) + s.energySlack;
+  iteration_ = 0;
+  status_ = QV_STEP_OK;
+  phase_ = Phase::First;
+  point_ = s.end.q;
+}
+
+void MinimizeTask::resume() {
+  qv_instance& s = *s_;
+  const int r = s.r;
+  Minimizer minimizer(s, p_);
+  switch (phase_) {
+    case Phase::First:
+      at_ = minimizer.evaluate(s.end.q, &elastic_);
+      iterate();
+      return;
+    case Phase::Trial: {
+      trial_ = minimizer.evaluate(s.work.trial, &trialElastic_);
+      const bool accepted = trial_.phi <= at_.phi + 1e-4 * length_ * slope_ ||
+                            (trial_.phi <= at_.phi + roundoff_ && norm(s.work.gradient, r) < gradient_);
+      if (accepted) {
+        std::memcpy(s.end.q, s.work.trial, sizeof(double) * r);
+        at_ = trial_;
+        elastic_ = trialElastic_;
+        ++iteration_;
+        iterate();
+        return;
+      }
+      ++s.lastStep.line_search_cuts;
+      length_ *= 0.5;
+      if (++cut_ < 30) {
+        for (int i = 0; i < r; ++i) s.work.trial[i] = s.end.q[i] + length_ * s.work.correction[i];
+        return;
+      }
+      phase_ = Phase::Restore;  // no length lowered Phi: x stays, with its forces and velocity
+      point_ = s.end.q;
+      return;
     }
-    if (it == s.config.newton_iterations) break;
-    bool failed = false;
-    if (minimizer.direction(at.jacobian, failed)) status = QV_STEP_INDEFINITE;
-    if (failed) break;
-    ++report.newton_iterations;
-    const double slope = dot(s.work.gradient, s.work.correction, r);  // < 0: a descent direction
-    // Backtracking: the first step length that lowers Phi enough (Armijo), or, near the minimum
-    // where Phi's change drowns in its rounding, one that keeps Phi within rounding and lowers the
-    // gradient. None, and x stays.
-    const double roundoff = 1e-12 * std::fabs(at.phi);
-    double length = 1;
-    bool accepted = false;
-    double trialElastic = 0;
-    Point trial;
-    for (int cut = 0; cut < 30 && !accepted; ++cut, length *= 0.5) {
-      for (int i = 0; i < r; ++i) s.work.trial[i] = x[i] + length * s.work.correction[i];
-      trial = minimizer.evaluate(s.work.trial, &trialElastic);
-      accepted = trial.phi <= at.phi + 1e-4 * length * slope ||
-                 (trial.phi <= at.phi + roundoff && norm(s.work.gradient, r) < gradient);
-      if (!accepted) ++report.line_search_cuts;
-    }
-    if (!accepted) {
-      at = minimizer.evaluate(x, &elastic);  // back to the last iterate's forces and velocity
-      break;
-    }
-    std::memcpy(x, s.work.trial, sizeof(double) * r);
-    at = trial;
-    elastic = trialElastic;
+    case Phase::Restore:
+      at_ = minimizer.evaluate(s.end.q, &elastic_);
+      finish();
+      return;
+    case Phase::Done:
+      return;
   }
+}
+
+void MinimizeTask::iterate() {
+  qv_instance& s = *s_;
+  const int r = s.r;
+  qv_step_report& report = s.lastStep;
+  gradient_ = norm(s.work.gradient, r);
+  if (!std::isfinite(gradient_) || !std::isfinite(at_.phi)) {  // non-finite input
+    status_ = QV_STEP_RESET;
+    phase_ = Phase::Done;
+    return;
+  }
+  report.gradient = gradient_ / (at_.scale + 1e-300);
+  if (gradient_ <= s.config.newton_tolerance * at_.scale) {
+    report.converged = 1;
+    return finish();
+  }
+  if (iteration_ == s.config.newton_iterations) return finish();
+  bool failed = false;
+  if (Minimizer(s, p_).direction(at_.jacobian, failed)) status_ = QV_STEP_INDEFINITE;
+  if (failed) return finish();
+  ++report.newton_iterations;
+  slope_ = dot(s.work.gradient, s.work.correction, r);  // < 0: a descent direction
+  // Backtracking: the first step length that lowers Phi enough (Armijo), or, near the minimum
+  // where Phi's change drowns in its rounding, one that keeps Phi within rounding and lowers the
+  // gradient. None, and x stays.
+  roundoff_ = 1e-12 * std::fabs(at_.phi);
+  length_ = 1;
+  cut_ = 0;
+  for (int i = 0; i < r; ++i) s.work.trial[i] = s.end.q[i] + s.work.correction[i];
+  phase_ = Phase::Trial;
+  point_ = s.work.trial;
+}
+
+void MinimizeTask::finish() {
+  qv_instance& s = *s_;
+  const int r = s.r;
   // Damping's share: h v_mid^T C0 v_mid, exact for the trapezoidal rule's linear damping.
   double* mid = s.work.midpointVelocity;
-  for (int i = 0; i < r; ++i) mid[i] = 0.5 * (s.v[i] + velocity[i]);
-  for (int i = 0; i < r; ++i) budget -= p.h * mid[i] * restDampingForce(s, i, mid);
-  holdToBudget(s, budget, x, velocity, elastic, report);
+  for (int i = 0; i < r; ++i) mid[i] = 0.5 * (s.v[i] + s.end.v[i]);
+  for (int i = 0; i < r; ++i) budget_ -= p_.h * mid[i] * restDampingForce(s, i, mid);
+  holdToBudget(s, budget_, s.end.q, s.end.v, elastic_, s.lastStep);
   // A step held back forfeits the slack: what it removed is not to be won back.
-  s.energySlack = report.held_back ? 0.0 : std::fmax(0.0, budget - stepEnergy(s, x, velocity, elastic));
-  s.elasticEnergyAtState = elastic;
-  return status;
+  s.energySlack = s.lastStep.held_back ? 0.0 : std::fmax(0.0, budget_ - stepEnergy(s, s.end.q, s.end.v, elastic_));
+  s.elasticEnergyAtState = elastic_;
+  phase_ = Phase::Done;
+}
+
+qv_step_status minimizeStep(qv_instance& s, const StepPredictor& p) {
+  MinimizeTask task;
+  task.begin(s, p);
+  while (task.pending()) task.resume();
+  return task.status();
 }
 
 } // namespace quiver::rt

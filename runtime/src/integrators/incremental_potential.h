@@ -29,8 +29,40 @@ struct StepPredictor {
 // (C0 v)_i, C0 = alpha I + beta K(0).
 double restDampingForce(const qv_instance& s, int i, const double* v);
 
-// Runs the minimisation from the guess in s.end.q, with qt in s.work.predictor and v0 in
-// s.work.predictorVelocity. On return s.end.q is x and s.end.v is v(x) after the energy budget.
+// Phi at one iterate, the force scale of its convergence test and the state forces' Jacobian.
+struct PhiPoint {
+  double phi = 0, scale = 0;
+  const double* jacobian = nullptr;
+};
+
+// One minimising step in parts between its evaluations, so that a group (step_many.h) can
+// evaluate its members' points together: begin(), then, while pending() names a point, resume()
+// (which evaluates there, or takes the group's preset evaluation of exactly that point) until
+// pending() is null, then status(). Plain data: a group keeps a few and moves them between lanes.
+class MinimizeTask {
+public:
+  // From the guess in s.end.q, with qt in s.work.predictor and v0 in s.work.predictorVelocity.
+  void begin(qv_instance& s, const StepPredictor& predictor);
+  const double* pending() const { return phase_ == Phase::Done ? nullptr : point_; }
+  void resume();
+  // Once done: s.end.q is x and s.end.v is v(x) after the energy budget.
+  qv_step_status status() const { return status_; }
+
+private:
+  enum class Phase { First, Trial, Restore, Done };
+  void iterate();   // at an accepted iterate: stop, or a Newton direction and its first trial point
+  void finish();    // the energy budget
+  qv_instance* s_ = nullptr;
+  StepPredictor p_{};
+  Phase phase_ = Phase::Done;
+  const double* point_ = nullptr;  // where resume() evaluates
+  int iteration_ = 0, cut_ = 0;
+  double budget_ = 0, elastic_ = 0, trialElastic_ = 0, gradient_ = 0, slope_ = 0, roundoff_ = 0, length_ = 0;
+  PhiPoint at_, trial_;
+  qv_step_status status_ = QV_STEP_OK;
+};
+
+// begin(), resume() until done, status().
 qv_step_status minimizeStep(qv_instance& s, const StepPredictor& predictor);
 
 } // namespace quiver::rt

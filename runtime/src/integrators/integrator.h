@@ -2,6 +2,7 @@
 // Time integrators. Each lives in its own file as one function that advances an instance by one
 // step; adding one means its file, a value of qv_integrator and a row of kIntegrators.
 #include "../instance.h"
+#include "incremental_potential.h"
 
 namespace quiver::rt {
 
@@ -24,6 +25,12 @@ struct SolverEntry {
 extern const SolverEntry kSolvers[QV_SOLVER_COUNT];
 
 qv_step_status stepImplicitNewmark(qv_instance& s);
+// Its minimising solver's step in parts (a group runs the middle, step_many.h): qt, v0 and the
+// guess; then, after the minimisation, the end of the step as its minimum, with Newmark's own
+// acceleration a' = 4/h^2 (x - qt) (the equations of motion's at convergence; bounded by the
+// potential when the iteration cap comes first), or none where the step was held back.
+StepPredictor beginNewmarkMinimization(qv_instance& s);
+qv_step_status endNewmarkMinimization(qv_instance& s, const StepPredictor& p, qv_step_status status);
 // Implicit Newmark's first guess at the end of the step, q + h v + h^2/2 a (the last acceleration
 // kept): where both solvers start, and where a group's preset is evaluated (step_many.h).
 inline double newmarkGuess(const qv_instance& s, int i) {
