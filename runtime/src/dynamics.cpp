@@ -8,19 +8,21 @@
 
 namespace quiver::rt {
 
-namespace {
-
-// The upper triangle only when `upper` (all Cholesky reads), else the whole matrix (LU).
-void fillSystem(qv_instance& s, const double* stateJacobian, double c1, double c2, bool upper) {
-  const double alpha = s.config.rayleigh_alpha, beta = s.config.rayleigh_beta;
+void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales& scales, bool upper) {
   const int r = s.r;
+  const double* K0 = s.model->restStiffness;
   for (int i = 0; i < r; ++i)
     for (int j = upper ? i : 0; j < r; ++j)
-      s.work.system[i * r + j] = (c1 * beta + c2) * s.work.stiffness[i * r + j] + c2 * stateJacobian[i * r + j] +
-                                 (i == j ? 1.0 + c1 * alpha : 0.0);
+      s.work.system[i * r + j] = scales.stiffness * s.work.stiffness[i * r + j] +
+                                 scales.stateJacobian * stateJacobian[i * r + j] + scales.restStiffness * K0[i * r + j] +
+                                 (i == j ? scales.identity : 0.0);
 }
 
-} // namespace
+bool takePresetFactor(qv_instance& s, const SystemScales& scales) {
+  const bool factored = s.work.presetFactored && scales == s.work.presetScales;
+  s.work.presetFactored = false;
+  return factored;
+}
 
 void elasticityAt(qv_instance& s, const double* q, double* energy, double* force) {
   const bool preset = s.work.presetValid && std::memcmp(q, s.work.presetAt, sizeof(double) * s.r) == 0;
@@ -40,18 +42,15 @@ const double* evaluateForces(qv_instance& s, const double* q) {
 }
 
 QV_HOT qv_step_status solveNewton(qv_instance& s, const double* stateJacobian, double c1, double c2) {
-  const bool factored = s.work.presetFactored && c1 == s.work.presetC1 && c2 == s.work.presetC2;
-  s.work.presetFactored = false;
-  if (factored) {
+  const SystemScales scales = newtonSystem(s, c1, c2);
+  if (takePresetFactor(s, scales)) {
     choleskySubstitute(s.work.system, s.work.correction, s.r);
     return QV_STEP_OK;
   }
-  fillSystem(s, stateJacobian, c1, c2, true);
-  // The Cholesky attempt spoils the matrix and the right-hand side, so keep the latter for a second try.
-  std::memcpy(s.work.retryRhs, s.work.correction, sizeof(double) * s.r);
+  fillSystem(s, stateJacobian, scales, true);
+  // The Cholesky attempt spoils the matrix, so the LU retry fills it again.
   if (choleskySolve(s.work.system, s.work.correction, s.r)) return QV_STEP_OK;
-  std::memcpy(s.work.correction, s.work.retryRhs, sizeof(double) * s.r);
-  fillSystem(s, stateJacobian, c1, c2, false);
+  fillSystem(s, stateJacobian, scales, false);
   return luSolve(s.work.system, s.work.correction, s.work.pivot, s.r) ? QV_STEP_INDEFINITE : QV_STEP_RESET;
 }
 

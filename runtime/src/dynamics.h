@@ -22,6 +22,19 @@ inline double dampingForce(const qv_instance& s, int i, const double* v) {
   return d;
 }
 
+// The fixed Newton step's (I + c1 C + c2 (K + J)), C = alpha I + beta K(q).
+inline SystemScales newtonSystem(const qv_instance& s, double c1, double c2) {
+  return {c1 * s.config.rayleigh_beta + c2, c2, 0.0, 1.0 + c1 * s.config.rayleigh_alpha};
+}
+
+// The matrix into s.work.system: its upper triangle only when `upper` (all Cholesky reads), else
+// the whole.
+void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales& scales, bool upper);
+
+// Whether s.work.system holds a group's Cholesky factor (step_many.h) of the matrix with these
+// scales at the point just evaluated; the factor is taken either way.
+bool takePresetFactor(qv_instance& s, const SystemScales& scales);
+
 // Solves the Newton system for the right-hand side in s.work.correction (the correction replaces
 // it): Cholesky, or pivoting LU (QV_STEP_INDEFINITE) when large compression has made the matrix
 // indefinite; QV_STEP_RESET when it is singular.

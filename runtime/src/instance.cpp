@@ -107,7 +107,6 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
   work.stiffness = c.take<double>(rr);
   work.system = c.take<double>(rr);
   work.correction = c.take<double>(r);
-  work.retryRhs = c.take<double>(r);
   work.predictor = c.take<double>(r);
   work.predictorVelocity = c.take<double>(r);
   work.gradient = c.take<double>(r);

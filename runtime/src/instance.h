@@ -17,13 +17,22 @@ struct EndOfStep {
   double* a = nullptr;
 };
 
+// The symmetric matrices both solvers factorise (dynamics.h): stiffness K(q) + stateJacobian J +
+// restStiffness K(0) + identity I, each term scaled.
+struct SystemScales {
+  double stiffness = 0, stateJacobian = 0, restStiffness = 0, identity = 0;
+  bool operator==(const SystemScales& o) const {
+    return stiffness == o.stiffness && stateJacobian == o.stateJacobian && restStiffness == o.restStiffness &&
+           identity == o.identity;
+  }
+};
+
 // What one evaluation at a trial state fills, and the Newton system built from it.
 struct StepBuffers {
   double* force = nullptr;        // R(q) plus the state forces (resisting: the step subtracts it)
   double* stiffness = nullptr;    // K(q), elastic only (Rayleigh damping uses it)
   double* system = nullptr;       // the Newton matrix, factorised in place
   double* correction = nullptr;   // the Newton right-hand side in, the correction out
-  double* retryRhs = nullptr;     // the right-hand side kept for the LU retry
   double* predictor = nullptr;    // the minimising solver's qt and v0 (incremental_potential.h)
   double* predictorVelocity = nullptr;
   double* gradient = nullptr;     // its gradient at the current iterate
@@ -40,11 +49,11 @@ struct StepBuffers {
   double* presetForce = nullptr;
   double presetEnergy = 0;
   bool presetValid = false;
-  // For a fixed Newton step the group also factorises the step's first Newton matrix at that
-  // point, (I + c1 C + c2 (K + J)), into `system`; solveNewton() takes it for the system with
-  // these c1 and c2 right after the preset was taken, instead of filling and factorising its own.
+  // The group also factorises the matrix the step will solve with at that point (the system with
+  // presetScales), into `system`; the solver takes it right after the preset (takePresetFactor(),
+  // dynamics.h) instead of filling and factorising its own.
   bool presetFactored = false;
-  double presetC1 = 0, presetC2 = 0;
+  SystemScales presetScales;
 };
 
 // Bytes of the block an instance with `config` needs (64-byte aligned).

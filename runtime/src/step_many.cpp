@@ -4,6 +4,8 @@
 #include <cstring>
 
 #include "cholesky_lanes.h"
+#include "dynamics.h"
+#include "simd_dispatch.h"
 #include "integrators/integrator.h"
 
 namespace quiver::rt {
@@ -19,15 +21,13 @@ bool groupable(const qv_instance& s) {
   return s.config.integrator == QV_INTEGRATOR_IMPLICIT_NEWMARK && s.config.elasticity == QV_ELASTICITY_STVK;
 }
 
-// Whose first Newton matrix the group factorises too: a fixed Newton step's, whose state forces'
-// Jacobian is the constraints' constant one (in flight it depends on q).
-bool factorisedInGroup(const qv_instance& s) {
-  return s.config.integrator == QV_INTEGRATOR_IMPLICIT_NEWMARK && s.config.solver == QV_SOLVER_NEWTON && !s.flying();
-}
+// Whether the group factorises the matrices a member's solver will solve with: not in flight, where
+// the state forces' Jacobian depends on q (elsewhere it is the constraints' constant one).
+bool factorisedInGroup(const qv_instance& s) { return !s.flying(); }
 
 // Copies the upper triangles of the group's packed lanes (evaluateLanes()'s layout) into the members'
 // row-major r x r matrices, row by row: a row's lanes are one short contiguous run.
-void unpackUpper(const double* lanes, int r, int count, double* const* out) {
+QV_HOT void unpackUpper(const double* lanes, int r, int count, double* const* out) {
   for (int a = 0; a < r; ++a) {
     const double* row = lanes + (packedUpperIndex(r, a, a) - static_cast<size_t>(a)) * kLanes;
     for (int l = 0; l < count; ++l)
@@ -35,51 +35,55 @@ void unpackUpper(const double* lanes, int r, int count, double* const* out) {
   }
 }
 
-// The group's first Newton matrices I + c1 C + c2 (K + J), the terms solveNewton() (dynamics.cpp)
-// builds, factorised together in `A` (K in, as evaluateLanes() leaves it) and each one's
-// factor handed to its step in `system`. Lanes without such a step factorise the identity.
-void factoriseGroup(qv_instance* const* group, int count, double* A) {
+// Factorises together the members' matrices with `scales` (system_scales in instance.h) at the
+// point just evaluated, `A` holding the group's K (as evaluateLanes() leaves it), and hands each
+// factor to its member's solver in `system` (presetFactored). Lanes not factorised
+// (factorisedInGroup()) factorise the identity.
+QV_HOT void factoriseGroup(qv_instance* const* group, int count, const SystemScales* scales, double* A) {
   const int r = group[0]->r;
-  double scaleK[kLanes], scaleJ[kLanes], diagonal[kLanes], c1[kLanes], c2[kLanes];
+  const double* K0 = group[0]->model->restStiffness;
+  SystemScales lane[kLanes];
   const double* J[kLanes];
-  bool constrained = false, any = false;
+  bool any = false, constrained = false, rest = false;
   for (int l = 0; l < kLanes; ++l) {
     const qv_instance& s = *group[l < count ? l : 0];
     const bool factorised = l < count && factorisedInGroup(s);
-    newmarkNewtonScales(s, c1[l], c2[l]);
-    scaleK[l] = factorised ? c1[l] * s.config.rayleigh_beta + c2[l] : 0.0;
-    scaleJ[l] = factorised ? c2[l] : 0.0;
-    diagonal[l] = factorised ? 1.0 + c1[l] * s.config.rayleigh_alpha : 1.0;
+    lane[l] = factorised ? scales[l] : SystemScales{0.0, 0.0, 0.0, 1.0};
     J[l] = s.loads.constraintK;  // zero while no constraint is active
-    constrained = constrained || (factorised && s.loads.constrained);
     any = any || factorised;
+    constrained = constrained || (factorised && s.loads.constrained);
+    rest = rest || lane[l].restStiffness != 0;
   }
   if (!any) return;
+  // The terms in fillSystem()'s order (dynamics.cpp).
   for (int a = 0, p = 0; a < r; ++a)
     for (int b = a; b < r; ++b, ++p) {
       double* x = A + p * kLanes;
-      for (int l = 0; l < kLanes; ++l) x[l] = scaleK[l] * x[l] + (a == b ? diagonal[l] : 0.0);
+      for (int l = 0; l < kLanes; ++l) x[l] *= lane[l].stiffness;
       if (constrained)
-        for (int l = 0; l < kLanes; ++l) x[l] += scaleJ[l] * J[l][a * r + b];
+        for (int l = 0; l < kLanes; ++l) x[l] += lane[l].stateJacobian * J[l][a * r + b];
+      if (rest)
+        for (int l = 0; l < kLanes; ++l) x[l] += lane[l].restStiffness * K0[a * r + b];
+      if (a == b)
+        for (int l = 0; l < kLanes; ++l) x[l] += lane[l].identity;
     }
   bool ok[kLanes];
   choleskyFactorLanes(A, r, ok);
-  double* system[kLanes];
+  double* system[kLanes] = {};
   for (int l = 0; l < count; ++l) system[l] = group[l]->work.system;
   unpackUpper(A, r, count, system);
   for (int l = 0; l < count; ++l) {
     qv_instance& s = *group[l];
-    // Not positive definite: the step's own solve decides (pivoting LU).
+    // Not positive definite: the solver's own factorisation decides (pivoting LU, or a shift).
     s.work.presetFactored = ok[l] && factorisedInGroup(s);
-    s.work.presetC1 = c1[l];
-    s.work.presetC2 = c2[l];
+    s.work.presetScales = lane[l];
   }
 }
 
 // Evaluates the members' polynomials together at their presetAt points and leaves each one's
 // preset for its step's next evaluation there: R(q) and E(q), K(q) in its `stiffness`; returns
 // the group's K packed by lane (evaluateLanes()) in `scratch`.
-double* evaluateTogether(qv_instance* const* members, int count, double* scratch) {
+QV_HOT double* evaluateTogether(qv_instance* const* members, int count, double* scratch) {
   const int r = members[0]->r;
   double* stiffnessLanes = scratch;  // [pair][lane]
   const double* at[kLanes] = {};
@@ -111,7 +115,13 @@ void stepNewtonGroup(qv_instance* const* group, const int* index, int count, dou
     s.beginOwnStep();
     for (int i = 0; i < s.r; ++i) s.work.presetAt[i] = newmarkGuess(s, i);
   }
-  factoriseGroup(group, count, evaluateTogether(group, count, scratch));
+  SystemScales scales[kLanes];
+  for (int l = 0; l < count; ++l) {
+    double c1, c2;
+    newmarkNewtonScales(*group[l], c1, c2);
+    scales[l] = newtonSystem(*group[l], c1, c2);
+  }
+  factoriseGroup(group, count, scales, evaluateTogether(group, count, scratch));
   for (int l = 0; l < count; ++l) {
     const qv_step_status status = group[l]->finishStep();
     if (statuses) statuses[index[l]] = status;
@@ -143,7 +153,10 @@ void stepMinimizingTogether(qv_instance* const* instances, Next next, double* sc
   while (active > 0) {
     for (int l = 0; l < active; ++l)
       std::memcpy(member[l]->work.presetAt, task[l].pending(), sizeof(double) * member[l]->r);
-    evaluateTogether(member, active, scratch);
+    // Each point's Newton matrix too, for the direction the step takes from it if it goes on.
+    SystemScales scales[kLanes];
+    for (int l = 0; l < active; ++l) scales[l] = minimizerSystem(*member[l], predictor[l]);
+    factoriseGroup(member, active, scales, evaluateTogether(member, active, scratch));
     for (int l = 0; l < active; ++l) task[l].resume();
     for (int l = 0; l < active;) {
       if (task[l].pending()) {

@@ -23,7 +23,7 @@ class Minimizer {
 public:
   // qt in s.work.predictor, v0 in s.work.predictorVelocity; v(x) into s.end.v.
   Minimizer(qv_instance& s, const StepPredictor& p)
-      : s_(s), p_(p), qt_(s.work.predictor), v0_(s.work.predictorVelocity), velocity_(s.end.v), r_(s.r), m_(*s.model) {}
+      : s_(s), p_(p), qt_(s.work.predictor), v0_(s.work.predictorVelocity), velocity_(s.end.v), r_(s.r) {}
 
   // Evaluates Phi at x and leaves its gradient in s.work.gradient, R + S' in s.work.force, K(x) in
   // s.work.stiffness, v(x) in `velocity` and E(x) in `elastic`.
@@ -54,19 +54,20 @@ public:
   // Newton direction into s.work.correction: (H + mu I) d = -g, mu the smallest of 0 and a growing
   // ladder that makes the Cholesky factorisation succeed. Returns whether a shift was needed.
   bool direction(const double* jacobian, bool& failed) {
-    const double diagonal = p_.w + p_.s * s_.config.rayleigh_alpha;
+    SystemScales scales = minimizerSystem(s_, p_);
+    for (int i = 0; i < r_; ++i) s_.work.correction[i] = -s_.work.gradient[i];
+    if (takePresetFactor(s_, scales)) {
+      choleskySubstitute(s_.work.system, s_.work.correction, r_);
+      return false;
+    }
+    const double diagonal = scales.identity;
     double largest = 0;
     for (int i = 0; i < r_; ++i)
       largest = std::fmax(largest, std::fabs(s_.work.stiffness[i * r_ + i]) + std::fabs(jacobian[i * r_ + i]));
     double mu = 0;
     for (int attempt = 0; attempt < 40; ++attempt) {
-      for (int i = 0; i < r_; ++i) {
-        for (int j = i; j < r_; ++j)  // the upper triangle: all Cholesky reads
-          s_.work.system[i * r_ + j] = s_.work.stiffness[i * r_ + j] + jacobian[i * r_ + j] +
-                                       p_.s * s_.config.rayleigh_beta * m_.restStiffness[i * r_ + j];
-        s_.work.system[i * r_ + i] += diagonal + mu;
-        s_.work.correction[i] = -s_.work.gradient[i];
-      }
+      scales.identity = diagonal + mu;
+      fillSystem(s_, jacobian, scales, true);
       if (choleskySolve(s_.work.system, s_.work.correction, r_)) return mu > 0;
       mu = mu > 0 ? 4 * mu : 1e-6 * (largest + diagonal);
     }
@@ -81,7 +82,6 @@ private:
   const double* v0_;
   double* velocity_;
   const int r_;
-  const qv_model& m_;
 };
 
 // H = |v|^2/2 + E + S - f^T q at this step's loads (v null: the potential alone).

@@ -29,6 +29,11 @@ struct StepPredictor {
 // (C0 v)_i, C0 = alpha I + beta K(0).
 double restDampingForce(const qv_instance& s, int i, const double* v);
 
+// Phi's Hessian w I + K(x) + J + s C0, the matrix of each Newton direction (before any shift).
+inline SystemScales minimizerSystem(const qv_instance& s, const StepPredictor& p) {
+  return {1.0, 1.0, p.s * s.config.rayleigh_beta, p.w + p.s * s.config.rayleigh_alpha};
+}
+
 // Phi at one iterate, the force scale of its convergence test and the state forces' Jacobian.
 struct PhiPoint {
   double phi = 0, scale = 0;
