@@ -150,7 +150,7 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   writePartition(*archive, partition, ctx.size());
   const DofLayout layout(ctx.comm(), partition.vertexPart, in.fixed);
   const AssembledSystem system =
-      stages.run("assemble", [&] { return assembleSystem(in.mesh.mesh, in.perTet, partition.tetPart, layout); });
+      stages.run("assemble", [&] { return assembleSystem(in.mesh.mesh, in.perTet, layout); });
   stages.report("K and M of " + std::to_string(layout.globalDofs()) + " DOFs");
   const Eigen::MatrixXd rigid = in.freeObject() ? rigidModes(in.mesh.mesh, system.mass, layout) : Eigen::MatrixXd();
 
@@ -162,7 +162,7 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   const bool derived = s.basis.userBasis.empty() && s.basis.settings.kind != BasisKind::Modes;
   const std::string derivativesHash = derivativesInputHash(modesHash);
   const ModalDerivatives derivatives =
-      derived ? derivativesStage(stages, ctx, in.mesh.mesh, in.perTet, partition.tetPart, system, layout, modes, rigid,
+      derived ? derivativesStage(stages, ctx, in.mesh.mesh, in.perTet, system, layout, modes, rigid,
                                  stiffnessFactor, derivativesHash)
               : ModalDerivatives{};
   stiffnessFactor.release();  // a copy of K and its factor per rank: not kept through the later stages

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "common/tet_mesh.h"
+
 #include <Eigen/Core>
 #include <mpi.h>
 
@@ -25,6 +27,15 @@ public:
   // Global row of vertex v's component c, or -1 when v is fixed.
   int64_t dof(int v, int c) const { return dofOfVertex_[v] < 0 ? -1 : dofOfVertex_[v] + c; }
   const std::vector<int>& ownedVertices() const { return ownedVertices_; }  // in row order
+  bool owns(int64_t row) const { return row >= rowStart_ && row < rowStart_ + localDofs_; }
+  // Whether this rank owns a row of any of a tet's vertices. Stages that sum element rows add every
+  // such tet, in tet order, into their own rows only: each row's sum then runs in the same order
+  // on every rank count and every run (no partial sums arriving from other ranks in message order).
+  bool ownsRowOf(const Tet& tet) const {
+    for (int v : tet)
+      if (owns(dof(v, 0))) return true;
+    return false;
+  }
   MPI_Comm comm() const { return comm_; }
 
   // Every rank gets the full 3n x cols matrix in vertex order (row 3v + c), zeros at fixed DOFs,

@@ -50,22 +50,23 @@ PetscMat createMatrix(const DofLayout& layout, const std::vector<PetscInt>& diag
 
 } // namespace
 
-AssembledSystem assembleSystem(const TetMesh& mesh, const std::vector<Material>& perTet,
-                               const std::vector<int>& tetPart, const DofLayout& layout) {
-  int rank = 0;
-  MPI_Comm_rank(layout.comm(), &rank);
+AssembledSystem assembleSystem(const TetMesh& mesh, const std::vector<Material>& perTet, const DofLayout& layout) {
   std::vector<PetscInt> diagonal, offDiagonal;
   countNonZeros(mesh, layout, diagonal, offDiagonal);
   AssembledSystem sys{createMatrix(layout, diagonal, offDiagonal), createMatrix(layout, diagonal, offDiagonal)};
 
   const TetElements elements = computeTetElements(mesh);
   const Eigen::Matrix3d atRest = Eigen::Matrix3d::Zero();  // displacement gradient at rest
-  PetscInt dofs[12];
+  PetscInt rows[12], columns[12];
   Eigen::Matrix<double, 12, 12, Eigen::RowMajor> Ke, Me;
   for (int t = 0; t < mesh.tetCount(); ++t) {
-    if (tetPart[t] != rank) continue;
+    const Tet& tet = mesh.tets[t];
+    if (!layout.ownsRowOf(tet)) continue;
     for (int a = 0; a < 4; ++a)
-      for (int c = 0; c < 3; ++c) dofs[3 * a + c] = static_cast<PetscInt>(layout.dof(mesh.tets[t][a], c));
+      for (int c = 0; c < 3; ++c) {
+        columns[3 * a + c] = static_cast<PetscInt>(layout.dof(tet[a], c));
+        rows[3 * a + c] = layout.owns(columns[3 * a + c]) ? columns[3 * a + c] : -1;
+      }
     const Material& m = perTet[t];
     const double V = elements.volume[t];
     Ke = stvkElementTangent(atRest, elements.gradients[t], V, m.lambda(), m.mu());
@@ -73,11 +74,13 @@ AssembledSystem assembleSystem(const TetMesh& mesh, const std::vector<Material>&
     for (int a = 0; a < 4; ++a)
       for (int b = 0; b < 4; ++b)
         Me.block<3, 3>(3 * a, 3 * b).diagonal().setConstant(m.density * V * consistentMassWeight(a, b));
-    // Negative indices (fixed DOFs) are ignored by PETSc: that is the elimination.
-    QV_PETSC(MatSetValues(sys.stiffness, 12, dofs, 12, dofs, Ke.data(), ADD_VALUES));
-    QV_PETSC(MatSetValues(sys.mass, 12, dofs, 12, dofs, Me.data(), ADD_VALUES));
+    // Negative indices are ignored by PETSc: fixed DOFs (that is the elimination) and, as rows,
+    // the DOFs other ranks own (they add this tet themselves).
+    QV_PETSC(MatSetValues(sys.stiffness, 12, rows, 12, columns, Ke.data(), ADD_VALUES));
+    QV_PETSC(MatSetValues(sys.mass, 12, rows, 12, columns, Me.data(), ADD_VALUES));
   }
   for (Mat A : {sys.stiffness.get(), sys.mass.get()}) {
+    QV_PETSC(MatSetOption(A, MAT_NO_OFF_PROC_ENTRIES, PETSC_TRUE));
     QV_PETSC(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY));
     QV_PETSC(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY));
   }

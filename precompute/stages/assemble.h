@@ -1,8 +1,9 @@
 #pragma once
 // Stage "assemble": the consistent mass M and the rest stiffness K(0) of the free DOFs as
-// distributed PETSc matrices (MPIAIJ), preallocated exactly. Each rank computes the element
-// matrices of the tets the partition gave it and adds them in (ADD_VALUES); rows of fixed DOFs
-// are never formed, which eliminates them.
+// distributed PETSc matrices (MPIAIJ), preallocated exactly. Each rank adds the element matrices
+// of every tet touching its rows, in tet order, into its own rows only (DofLayout::ownsRowOf): the
+// same bits on every rank count and every run. Rows of fixed DOFs are never formed, which
+// eliminates them.
 #include <vector>
 
 #include <petscmat.h>
@@ -20,8 +21,7 @@ struct AssembledSystem {
   PetscMat mass;       // consistent mass, symmetric positive definite
 };
 
-// `tetPart` from the partition; `perTet` one material per tet. Collective over layout.comm().
-AssembledSystem assembleSystem(const TetMesh& mesh, const std::vector<Material>& perTet,
-                               const std::vector<int>& tetPart, const DofLayout& layout);
+// `perTet` one material per tet. Collective over layout.comm().
+AssembledSystem assembleSystem(const TetMesh& mesh, const std::vector<Material>& perTet, const DofLayout& layout);
 
 } // namespace quiver

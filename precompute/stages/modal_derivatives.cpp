@@ -16,40 +16,29 @@ namespace quiver {
 
 namespace {
 
-// -d^2R[phi_i, phi_j] for every pair: this rank's rows (free DOFs x pairs). Each rank integrates its
-// own tets. Rows of its own DOFs add up in place, each DOF's pairs side by side (a tet adds 12
-// contiguous rows, not 12 x pairs scattered values); rows of DOFs another rank owns go there through
-// a distributed matrix (the partition's interface only).
-Eigen::MatrixXd rightHandSides(const TetMesh& mesh, const std::vector<Material>& perTet, const std::vector<int>& tetPart,
-                               const DofLayout& layout, const Eigen::MatrixXd& fullModes,
-                               const std::vector<std::array<int, 2>>& pairs) {
+// -d^2R[phi_i, phi_j] for every pair: this rank's rows (free DOFs x pairs). Each rank integrates
+// every tet touching its rows, in tet order (DofLayout::ownsRowOf: the same bits on every rank count
+// and every run; the tets on the partition's interface are integrated on each rank they touch), and
+// adds its own rows in place, each DOF's pairs side by side (a tet adds 12 contiguous rows, not
+// 12 x pairs scattered values).
+Eigen::MatrixXd rightHandSides(const TetMesh& mesh, const std::vector<Material>& perTet, const DofLayout& layout,
+                               const Eigen::MatrixXd& fullModes, const std::vector<std::array<int, 2>>& pairs) {
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  int rank = 0, size = 1;
-  MPI_Comm_rank(layout.comm(), &rank);
-  MPI_Comm_size(layout.comm(), &size);
-  const PetscInt P = static_cast<PetscInt>(pairs.size());
-  const int64_t first = layout.rowStart(), local = layout.localDofs();
-  RowMajor own = RowMajor::Zero(local, P);
-  PetscMat others;
-  if (size > 1) {
-    QV_PETSC(MatCreateDense(layout.comm(), local, PETSC_DECIDE, layout.globalDofs(), P, nullptr, others.out()));
-    QV_PETSC(MatZeroEntries(others));
-  }
+  const Eigen::Index P = static_cast<Eigen::Index>(pairs.size());
+  RowMajor own = RowMajor::Zero(layout.localDofs(), P);
   const TetElements elements = computeTetElements(mesh);
-  std::vector<PetscInt> columns(P);
-  for (PetscInt p = 0; p < P; ++p) columns[p] = p;
   std::vector<RestDirection> modeOnTet(fullModes.cols());
   RowMajor values(12, P);
   for (int t = 0; t < mesh.tetCount(); ++t) {
-    if (tetPart[t] != rank) continue;
     const Tet& tet = mesh.tets[t];
+    if (!layout.ownsRowOf(tet)) continue;
     const Material& m = perTet[t];
     for (int i = 0; i < fullModes.cols(); ++i) {  // each mode's H and delta S once per tet, not per pair
       Matrix34 onTet;
       for (int a = 0; a < 4; ++a) onTet.col(a) = fullModes.block<3, 1>(3 * tet[a], i);
       modeOnTet[i] = stvkRestDirection(onTet, elements.gradients[t], m.lambda(), m.mu());
     }
-    for (PetscInt p = 0; p < P; ++p) {
+    for (Eigen::Index p = 0; p < P; ++p) {
       const Matrix34 f = stvkElementForceHessianAtRest(modeOnTet[pairs[p][0]], modeOnTet[pairs[p][1]],
                                                        elements.gradients[t], elements.volume[t], m.lambda(), m.mu());
       values.col(p) = -Eigen::Map<const Eigen::Matrix<double, 12, 1>>(f.data());
@@ -57,22 +46,10 @@ Eigen::MatrixXd rightHandSides(const TetMesh& mesh, const std::vector<Material>&
     for (int a = 0; a < 4; ++a)
       for (int c = 0; c < 3; ++c) {
         const int64_t dof = layout.dof(tet[a], c);
-        if (dof < 0) continue;  // fixed
-        if (dof >= first && dof < first + local) {
-          own.row(dof - first) += values.row(3 * a + c);
-        } else {
-          const PetscInt row = static_cast<PetscInt>(dof);
-          QV_PETSC(MatSetValues(others, 1, &row, P, columns.data(), values.row(3 * a + c).data(), ADD_VALUES));
-        }
+        if (layout.owns(dof)) own.row(dof - layout.rowStart()) += values.row(3 * a + c);
       }
   }
-  Eigen::MatrixXd out = own;
-  if (size > 1) {
-    QV_PETSC(MatAssemblyBegin(others, MAT_FINAL_ASSEMBLY));
-    QV_PETSC(MatAssemblyEnd(others, MAT_FINAL_ASSEMBLY));
-    out += localRows(others, layout);
-  }
-  return out;
+  return own;
 }
 
 // Six DOFs whose pinning removes exactly the rigid motions: all of a vertex a, the two components
@@ -101,9 +78,8 @@ std::vector<PetscInt> pinnedDofs(const TetMesh& mesh, const DofLayout& layout) {
 
 } // namespace
 
-ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<Material>& perTet,
-                                         const std::vector<int>& tetPart, Mat stiffness, Mat mass,
-                                         const DofLayout& layout, const LinearModes& modes,
+ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<Material>& perTet, Mat stiffness,
+                                         Mat mass, const DofLayout& layout, const LinearModes& modes,
                                          const Eigen::MatrixXd& rigid, const DerivativeSettings& settings,
                                          StiffnessFactor* sharedFactor) {
   ModalDerivatives out;
@@ -112,7 +88,7 @@ ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<
     for (int j = i; j < k; ++j) out.pairs.push_back({i, j});
 
   // Right-hand sides; projected below on free objects.
-  Eigen::MatrixXd b = rightHandSides(mesh, perTet, tetPart, layout, layout.gatherToAll(modes.vectors), out.pairs);
+  Eigen::MatrixXd b = rightHandSides(mesh, perTet, layout, layout.gatherToAll(modes.vectors), out.pairs);
   Eigen::MatrixXd solveFor;                    // what the (possibly pinned) system is solved for
   const bool freeObject = rigid.cols() > 0;
   PetscMat pinned;
@@ -191,8 +167,7 @@ std::string describeDerivatives(const ModalDerivatives& derivatives) {
 }
 
 ModalDerivatives derivativesStage(StageRunner& stages, const BakeContext& ctx, const TetMesh& mesh,
-                                  const std::vector<Material>& perTet, const std::vector<int>& tetPart,
-                                  const AssembledSystem& system, const DofLayout& layout, const LinearModes& modes,
+                                  const std::vector<Material>& perTet, const AssembledSystem& system, const DofLayout& layout, const LinearModes& modes,
                                   const Eigen::MatrixXd& rigid, StiffnessFactor& factor, const std::string& inputHash) {
   bool reused = false;
   const ModalDerivatives derivatives = stages.checkpointed(
@@ -201,7 +176,7 @@ ModalDerivatives derivativesStage(StageRunner& stages, const BakeContext& ctx, c
         ProgressMeter meter(ctx, "derivatives", "solved");
         DerivativeSettings settings;
         settings.progress = meter.callback();
-        return computeModalDerivatives(mesh, perTet, tetPart, system.stiffness, system.mass, layout, modes, rigid,
+        return computeModalDerivatives(mesh, perTet, system.stiffness, system.mass, layout, modes, rigid,
                                        settings, &factor);
       },
       [&](Archive& a, const ModalDerivatives& d, const std::string& h) { writeDerivatives(a, d, layout, h); }, reused);

@@ -59,8 +59,8 @@ std::vector<double> eigenResiduals(Mat stiffness, Mat mass, const std::vector<do
 
 // Checkpoint: group /modes. Input hash: the mesh stage's, k, the solver, the PETSc/SLEPc options
 // given, and the stage's version tag (2: the solvers that give the same bits every run on several
-// ranks; 3: the block solver).
-inline constexpr const char* kModesVersion = "modes 3";
+// ranks; 3: the block solver; 4: K and M summed in tet order on every rank count).
+inline constexpr const char* kModesVersion = "modes 4";
 std::string modesInputHash(const std::string& meshHash, int count, Eigensolver solver, const std::string& petscOptions);
 void writeModes(Archive& archive, const LinearModes& modes, const DofLayout& layout, const std::string& inputHash);
 LinearModes readModes(const Archive& archive, const DofLayout& layout);

@@ -53,7 +53,7 @@ struct Problem {
         if (mesh.vertices[v].x() == 0) fixed.push_back(v);
     partition = partitionMesh(mesh, {size});
     layout = std::make_unique<DofLayout>(MPI_COMM_WORLD, partition.vertexPart, fixed);
-    system = assembleSystem(mesh, perTet, partition.tetPart, *layout);
+    system = assembleSystem(mesh, perTet, *layout);
     if (free) rigid = rigidModes(mesh, system.mass, *layout);
 
     model = std::make_unique<StVKForceModel>(mesh, perTet);
@@ -72,7 +72,7 @@ struct Problem {
     return computeLinearModes(system.stiffness, system.mass, *layout, settings, rigid);
   }
   ModalDerivatives derivatives(const LinearModes& m) const {
-    return computeModalDerivatives(mesh, perTet, partition.tetPart, system.stiffness, system.mass, *layout, m, rigid,
+    return computeModalDerivatives(mesh, perTet, system.stiffness, system.mass, *layout, m, rigid,
                                    DerivativeSettings{});
   }
 
@@ -180,6 +180,44 @@ TEST_P(BakeStages, BothSolversMatchTheDenseSolveOnAFinerBar) {
 }
 
 // A fixed object's derivatives through the modes' factor of K are the ones a factor of their own gives.
+// Every rank adds every tet touching its rows, in tet order: K and M are the serial assembly's
+// bits on any rank count (and so in any run: no partial sums arrive from other ranks in message
+// order). Each rank compares its rows with an assembly of its own on MPI_COMM_SELF.
+TEST(BakeStages, AssembledMatricesAreTheSerialBitsOnEveryRankCount) {
+  for (bool free : {false, true}) {
+    Problem p(free, {8, 3, 3});
+    const Partition one = partitionMesh(p.mesh, {1});
+    const DofLayout serialLayout(MPI_COMM_SELF, one.vertexPart, p.fixed);
+    const AssembledSystem serial = assembleSystem(p.mesh, p.perTet, serialLayout);
+    std::vector<int> vertexOfRow(p.layout->globalDofs() / 3);
+    for (int v = 0; v < p.mesh.vertexCount(); ++v)
+      if (p.layout->dof(v, 0) >= 0) vertexOfRow[p.layout->dof(v, 0) / 3] = v;
+    long compared = 0, differ = 0;
+    for (const auto& [distributed, reference] :
+         {std::pair{p.system.stiffness.get(), serial.stiffness.get()}, std::pair{p.system.mass.get(), serial.mass.get()}})
+      for (int v : p.layout->ownedVertices())
+        for (int c = 0; c < 3; ++c) {
+          const PetscInt row = static_cast<PetscInt>(p.layout->dof(v, c));
+          const PetscInt serialRow = static_cast<PetscInt>(serialLayout.dof(v, c));
+          PetscInt n = 0;
+          const PetscInt* columns = nullptr;
+          const PetscScalar* values = nullptr;
+          ASSERT_EQ(MatGetRow(distributed, row, &n, &columns, &values), 0);
+          const PetscInt count = n;  // MatRestoreRow zeroes n
+          std::vector<PetscInt> serialColumns(count);
+          std::vector<PetscScalar> mine(values, values + count), theirs(count);
+          for (PetscInt i = 0; i < count; ++i)
+            serialColumns[i] = static_cast<PetscInt>(serialLayout.dof(vertexOfRow[columns[i] / 3], columns[i] % 3));
+          ASSERT_EQ(MatRestoreRow(distributed, row, &n, &columns, &values), 0);
+          ASSERT_EQ(MatGetValues(reference, 1, &serialRow, count, serialColumns.data(), theirs.data()), 0);
+          for (PetscInt i = 0; i < count; ++i) differ += mine[i] != theirs[i];
+          compared += count;
+        }
+    EXPECT_EQ(differ, 0) << "of " << compared << " entries, free " << free;
+    EXPECT_GT(compared, 0);
+  }
+}
+
 TEST(BakeStages, DerivativesThroughTheSharedFactorAreTheSame) {
   Problem p(false);
   StiffnessFactor shared(p.system.stiffness, *p.layout);
@@ -187,7 +225,7 @@ TEST(BakeStages, DerivativesThroughTheSharedFactorAreTheSame) {
   settings.count = 3;
   const LinearModes modes = computeLinearModes(p.system.stiffness, p.system.mass, *p.layout, settings, p.rigid, &shared);
   const ModalDerivatives own = p.derivatives(modes);
-  const ModalDerivatives reused = computeModalDerivatives(p.mesh, p.perTet, p.partition.tetPart, p.system.stiffness,
+  const ModalDerivatives reused = computeModalDerivatives(p.mesh, p.perTet, p.system.stiffness,
                                                           p.system.mass, *p.layout, modes, p.rigid, DerivativeSettings{},
                                                           &shared);
   EXPECT_EQ((own.vectors - reused.vectors).cwiseAbs().maxCoeff(), 0.0);

@@ -47,7 +47,7 @@ TEST(ModelChain, RuntimeEvaluatesTheFullSpaceProjection) {
   std::vector<Material> perTet(mesh.mesh.tetCount());
   Partition part = partitionMesh(mesh.mesh, {size});
   DofLayout layout(MPI_COMM_WORLD, part.vertexPart, fixed);
-  AssembledSystem sys = assembleSystem(mesh.mesh, perTet, part.tetPart, layout);
+  AssembledSystem sys = assembleSystem(mesh.mesh, perTet, layout);
   ModeSettings ms;
   ms.count = 6;
   LinearModes modes = computeLinearModes(sys.stiffness, sys.mass, layout, ms, Eigen::MatrixXd());
