@@ -125,10 +125,9 @@ public:
     for (double& b : B_) b = u(rng);
   }
   void operator()() {
-    const int ld = 6 * block_;
     for (int64_t first = 0; first < tets_; first += block_) {
       const int count = static_cast<int>(std::min<int64_t>(block_, tets_ - first));
-      cblas_dsyrk(CblasColMajor, CblasUpper, CblasTrans, N_, 6 * count, 1.0, B_.data(), ld, 1.0, gram_.data(), N_);
+      cblas_dsyrk(CblasColMajor, CblasUpper, CblasNoTrans, N_, 6 * count, 1.0, B_.data(), N_, 1.0, gram_.data(), N_);
     }
   }
 

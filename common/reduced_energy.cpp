@@ -47,26 +47,34 @@ void ReducedEnergyRows::write(const Tet& tet, const Matrix34& grad, double volum
       }
     }
   const auto g = [&](int c, int d) { return g_.data() + (3 * c + d) * r; };
-  // C with C^T C = V (mu W + lambda/2 t t^T): rows of B are C times the Voigt columns.
+  // C with C^T C = V (mu W + lambda/2 t t^T): row i of B is row i of C times the Voigt components.
   const Eigen::Matrix<double, 6, 6> C = energyFactor(volume, material.lambda(), material.mu());
   const double c00 = C(0, 0), c01 = C(0, 1), c02 = C(0, 2), c11 = C(1, 1), c12 = C(1, 2), c22 = C(2, 2), cs = C(3, 3);
-  const auto put = [&](int64_t column, double xx, double yy, double zz, double yz, double xz, double xy) {
-    double* b = B + column * ld;
-    b[0] = c00 * xx + c01 * yy + c02 * zz;
-    b[1] = c11 * yy + c12 * zz;
-    b[2] = c22 * zz;
-    b[3] = cs * yz;
-    b[4] = cs * xz;
-    b[5] = cs * xy;
+  double* b[6];
+  for (int i = 0; i < 6; ++i) b[i] = B + i * ld;
+  // Columns [first, first + n) of B from the six Voigt components over them.
+  const auto put = [&](int64_t first, int n, const double* xx, const double* yy, const double* zz, const double* yz,
+                       const double* xz, const double* xy) {
+    for (int k = 0; k < n; ++k) {
+      b[0][first + k] = c00 * xx[k] + c01 * yy[k] + c02 * zz[k];
+      b[1][first + k] = c11 * yy[k] + c12 * zz[k];
+      b[2][first + k] = c22 * zz[k];
+      b[3][first + k] = cs * yz[k];
+      b[4][first + k] = cs * xz[k];
+      b[5][first + k] = cs * xy[k];
+    }
   };
   // Linear part: column j is sym(G_j).
-  for (int j = 0; j < r; ++j)
-    put(j, g(0, 0)[j], g(1, 1)[j], g(2, 2)[j], 0.5 * (g(1, 2)[j] + g(2, 1)[j]), 0.5 * (g(0, 2)[j] + g(2, 0)[j]),
-        0.5 * (g(0, 1)[j] + g(1, 0)[j]));
+  double* e = strain_.data();
+  for (int j = 0; j < r; ++j) {
+    e[3 * r + j] = 0.5 * (g(1, 2)[j] + g(2, 1)[j]);
+    e[4 * r + j] = 0.5 * (g(0, 2)[j] + g(2, 0)[j]);
+    e[5 * r + j] = 0.5 * (g(0, 1)[j] + g(1, 0)[j]);
+  }
+  put(0, r, g(0, 0), g(1, 1), g(2, 2), e + 3 * r, e + 4 * r, e + 5 * r);
   // Quadratic part: column (j, k), k >= j, is sym(G_j^T G_k) (halved on the diagonal): for each j,
   // the six components as vector loops over k.
   int64_t column = r;
-  double* e = strain_.data();
   for (int j = 0; j < r; ++j) {
     for (int k = j; k < r; ++k) {
       double xx = 0, yy = 0, zz = 0, yz = 0, xz = 0, xy = 0;
@@ -84,7 +92,8 @@ void ReducedEnergyRows::write(const Tet& tet, const Matrix34& grad, double volum
       e[k] = xx, e[r + k] = yy, e[2 * r + k] = zz, e[3 * r + k] = 0.5 * yz, e[4 * r + k] = 0.5 * xz, e[5 * r + k] = 0.5 * xy;
     }
     for (int m = 0; m < 6; ++m) e[m * r + j] *= 0.5;  // z_jj = q_j^2 enters once: G_j^T G_j / 2
-    for (int k = j; k < r; ++k) put(column++, e[k], e[r + k], e[2 * r + k], e[3 * r + k], e[4 * r + k], e[5 * r + k]);
+    put(column, r - j, e + j, e + r + j, e + 2 * r + j, e + 3 * r + j, e + 4 * r + j, e + 5 * r + j);
+    column += r - j;
   }
 }
 
@@ -94,9 +103,10 @@ Eigen::MatrixXd reducedEnergyGram(const TetMesh& mesh, const std::vector<Materia
   std::vector<int> all(mesh.tetCount());
   for (int t = 0; t < mesh.tetCount(); ++t) all[t] = t;
   ReducedEnergyRows rows(basis, mesh, all);
-  Eigen::MatrixXd B(6, rows.columns()), gram = Eigen::MatrixXd::Zero(rows.columns(), rows.columns());
+  Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor> B(6, rows.columns());
+  Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(rows.columns(), rows.columns());
   for (int t = 0; t < mesh.tetCount(); ++t) {
-    rows.write(mesh.tets[t], elements.gradients[t], elements.volume[t], perTet[t], B.data(), 6);
+    rows.write(mesh.tets[t], elements.gradients[t], elements.volume[t], perTet[t], B.data(), rows.columns());
     gram.selfadjointView<Eigen::Upper>().rankUpdate(B.transpose());
   }
   return gram;

@@ -25,14 +25,14 @@ namespace quiver {
 // Writes the six rows of B_e, tet after tet; its scratch is sized once so the loop allocates nothing.
 // It keeps the basis rows of the tets it will see vertex-major (each vertex's 3 x r block
 // contiguous: a tet reads four runs of memory) and builds each tet's G_j entry by entry as arrays
-// over j, so that the products G_j^T G_k run as vector loops over k.
+// over j, so that the products G_j^T G_k, and the rows of B_e, run as vector loops over k.
 class ReducedEnergyRows {
 public:
   // `basis`: 3n x r, vertex order; `tets`: the tets of `mesh` that write() will be given.
   ReducedEnergyRows(const Eigen::MatrixXd& basis, const TetMesh& mesh, const std::vector<int>& tets);
   int columns() const { return r_ + r_ * (r_ + 1) / 2; }
 
-  // B: column-major, leading dimension `ld` (>= 6).
+  // B_e (6 x columns()) row by row: row i at B + i * ld (ld >= columns()).
   void write(const Tet& tet, const Matrix34& gradients, double volume, const Material& material, double* B, int64_t ld);
 
 private:

@@ -25,17 +25,16 @@ EnergyPolynomial computeEnergyPolynomial(MPI_Comm comm, const TetMesh& mesh, con
 
   const TetElements elements = computeTetElements(mesh);
   const int block = std::max(1, settings.tetsPerBlock);
-  const int64_t ld = 6 * static_cast<int64_t>(block);
-  std::vector<double> B(static_cast<size_t>(ld) * N);
+  // The block's rows B_e^T side by side: N x 6 block, column-major (each row of B_e one contiguous run).
+  std::vector<double> B(6 * static_cast<size_t>(block) * N);
   Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(N, N);
   for (size_t first = 0; first < mine.size(); first += block) {
     const int count = static_cast<int>(std::min<size_t>(block, mine.size() - first));
     for (int b = 0; b < count; ++b) {
       const int t = mine[first + b];
-      rows.write(mesh.tets[t], elements.gradients[t], elements.volume[t], perTet[t], B.data() + 6 * b, ld);
+      rows.write(mesh.tets[t], elements.gradients[t], elements.volume[t], perTet[t], B.data() + 6 * b * static_cast<int64_t>(N), N);
     }
-    cblas_dsyrk(CblasColMajor, CblasUpper, CblasTrans, N, 6 * count, 1.0, B.data(), static_cast<int>(ld), 1.0,
-                gram.data(), N);
+    cblas_dsyrk(CblasColMajor, CblasUpper, CblasNoTrans, N, 6 * count, 1.0, B.data(), N, 1.0, gram.data(), N);
     if (settings.progress) settings.progress(static_cast<int64_t>(first + count), static_cast<int64_t>(mine.size()));
   }
   EnergyPolynomial out;

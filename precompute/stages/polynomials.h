@@ -19,7 +19,9 @@
 namespace quiver {
 
 struct PolynomialSettings {
-  int tetsPerBlock = 256;     // tets stacked per dsyrk call (6 rows each)
+  // Tets stacked per dsyrk call (6 rows each). 32: the block (0.76 MB at r = 30) is still in L2
+  // when the dsyrk reads it; 256 took 10% longer at r = 30 (bench/README.md).
+  int tetsPerBlock = 32;
   ProgressCallback progress;  // (tets done on this rank, tets of this rank); optional
 };
 
