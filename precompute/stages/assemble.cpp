@@ -43,6 +43,7 @@ PetscMat createMatrix(const DofLayout& layout, const std::vector<PetscInt>& diag
   QV_PETSC(MatCreateAIJ(layout.comm(), layout.localDofs(), layout.localDofs(), layout.globalDofs(),
                         layout.globalDofs(), 0, diagonal.data(), 0, offDiagonal.data(), A.out()));
   QV_PETSC(MatSetOption(A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  QV_PETSC(MatSetOption(A, MAT_NO_OFF_PROC_ENTRIES, PETSC_TRUE));  // each rank adds its own rows only
   QV_PETSC(MatSetOption(A, MAT_SYMMETRIC, PETSC_TRUE));
   QV_PETSC(MatSetOption(A, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
   return A;
@@ -80,7 +81,6 @@ AssembledSystem assembleSystem(const TetMesh& mesh, const std::vector<Material>&
     QV_PETSC(MatSetValues(sys.mass, 12, rows, 12, columns, Me.data(), ADD_VALUES));
   }
   for (Mat A : {sys.stiffness.get(), sys.mass.get()}) {
-    QV_PETSC(MatSetOption(A, MAT_NO_OFF_PROC_ENTRIES, PETSC_TRUE));
     QV_PETSC(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY));
     QV_PETSC(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY));
   }

@@ -39,7 +39,7 @@ EnergyPolynomial computeEnergyPolynomial(MPI_Comm comm, const TetMesh& mesh, con
                                          const PolynomialSettings& settings);
 
 // Checkpoint: group /polynomials. Input hash: the basis's and the stage's version tag.
-inline constexpr const char* kPolynomialsVersion = "polynomials 1";
+inline constexpr const char* kPolynomialsVersion = "polynomials 2";
 std::string polynomialInputHash(const std::string& basisHash);
 void writePolynomial(Archive& archive, const EnergyPolynomial& energy, const std::string& inputHash);
 EnergyPolynomial readPolynomial(const Archive& archive);

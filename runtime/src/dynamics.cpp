@@ -21,12 +21,13 @@ void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales&
 bool takePresetFactor(qv_instance& s, const SystemScales& scales) {
   const bool factored = s.work.presetFactored && scales == s.work.presetScales;
   s.work.presetFactored = false;
+  s.work.presetFactorsTaken += factored;
   return factored;
 }
 
 void elasticityAt(qv_instance& s, const double* q, double* energy, double* force) {
   const bool preset = s.work.presetValid && std::memcmp(q, s.work.presetAt, sizeof(double) * s.r) == 0;
-  s.work.presetValid = false;  // only ever the first evaluation: the next is elsewhere
+  s.work.presetValid = false;  // only ever the next evaluation: the one after is elsewhere
   s.work.presetFactored = s.work.presetFactored && preset;
   if (preset) {
     std::memcpy(force, s.work.presetForce, sizeof(double) * s.r);

@@ -3,13 +3,14 @@
 // them (M = I: the basis is mass-orthonormal; C = alpha I + beta K(q), Rayleigh; S the state
 // forces of loads.h, Jacobian J): forces, damping, and the Newton system
 //   (I + c1 C + c2 (K + J)) x = rhs.
+#include <cmath>
+
 #include "instance.h"
 
 namespace quiver::rt {
 
 // E(q) (when `energy` is not null), R(q) into `force` and K(q) into s.work.stiffness: the
-// group's preset when it was evaluated at exactly q (the step's first guess, step_many.h), else
-// evaluated now.
+// group's preset when it was evaluated at exactly q (step_many.h), else evaluated now.
 void elasticityAt(qv_instance& s, const double* q, double* energy, double* force);
 
 // Fills s.work.force = R(q) + S(q) and s.work.stiffness = K(q); returns J.
@@ -22,9 +23,11 @@ inline double dampingForce(const qv_instance& s, int i, const double* v) {
   return d;
 }
 
-// The fixed Newton step's (I + c1 C + c2 (K + J)), C = alpha I + beta K(q).
+// The fixed Newton step's (I + c1 C + c2 (K + J)), C = alpha I + beta K(q). Fused explicitly: the
+// group and the solver compute it in code built for different instruction sets, and a group's
+// factor is taken only when their scales agree bit for bit (takePresetFactor()).
 inline SystemScales newtonSystem(const qv_instance& s, double c1, double c2) {
-  return {c1 * s.config.rayleigh_beta + c2, c2, 0.0, 1.0 + c1 * s.config.rayleigh_alpha};
+  return {std::fma(c1, s.config.rayleigh_beta, c2), c2, 0.0, std::fma(c1, s.config.rayleigh_alpha, 1.0)};
 }
 
 // The matrix into s.work.system: its upper triangle only when `upper` (all Cholesky reads), else

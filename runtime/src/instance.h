@@ -30,7 +30,8 @@ struct SystemScales {
 // What one evaluation at a trial state fills, and the Newton system built from it.
 struct StepBuffers {
   double* force = nullptr;        // R(q) plus the state forces (resisting: the step subtracts it)
-  double* stiffness = nullptr;    // K(q), elastic only (Rayleigh damping uses it)
+  double* stiffness = nullptr;    // K(q), elastic only (Rayleigh damping uses it); after a group's
+                                  // evaluation for a minimising step, its upper triangle only
   double* system = nullptr;       // the Newton matrix, factorised in place
   double* correction = nullptr;   // the Newton right-hand side in, the correction out
   double* predictor = nullptr;    // the minimising solver's qt and v0 (incremental_potential.h)
@@ -42,8 +43,8 @@ struct StepBuffers {
   double* stateForceSink = nullptr;    // where stepEnergy() lets the state forces add the force it does not need
   int* pivot = nullptr;           // LU's row exchanges
   double* polynomialScratch = nullptr;
-  // A group stepped together (step_many.h) evaluates each member's polynomial at its step's first
-  // guess before the steps: R(q) and E(q) here, K(q) in `stiffness`. The step's first elastic
+  // A group stepped together (step_many.h) evaluates each member's polynomial at the point its
+  // step will evaluate next: R(q) and E(q) here, K(q) in `stiffness`. The step's next elastic
   // evaluation takes them when it is at exactly that point (elasticityAt(), dynamics.h).
   double* presetAt = nullptr;
   double* presetForce = nullptr;
@@ -54,6 +55,7 @@ struct StepBuffers {
   // dynamics.h) instead of filling and factorising its own.
   bool presetFactored = false;
   SystemScales presetScales;
+  unsigned long long presetFactorsTaken = 0;  // solves that took a group's factor (tests, diagnostics)
 };
 
 // Bytes of the block an instance with `config` needs (64-byte aligned).

@@ -15,7 +15,7 @@ namespace {
 constexpr int L = ReducedPolynomial::kLanes;
 
 // y[s] += Q[p][s] x[p] for s > p and y[p] += Q[p][s] x[s], as packedSymmetricProduct() does for
-// one state, four rows of one 8-aligned group per sweep (they share their first column).
+// one state, here four rows of one 8-aligned group per sweep (they share their first column).
 template <class C>
 QV_HOT void packedSymmetricProductLanes(const C* Q, const size_t* rowStart, const size_t* rowOffset, size_t n,
                                         const double* x, double* y) {

@@ -35,7 +35,7 @@ QV_HOT void unpackUpper(const double* lanes, int r, int count, double* const* ou
   }
 }
 
-// Factorises together the members' matrices with `scales` (system_scales in instance.h) at the
+// Factorises together the members' matrices with `scales` (SystemScales, instance.h) at the
 // point just evaluated, `A` holding the group's K (as evaluateLanes() leaves it), and hands each
 // factor to its member's solver in `system` (presetFactored). Lanes not factorised
 // (factorisedInGroup()) factorise the identity.
@@ -81,8 +81,9 @@ QV_HOT void factoriseGroup(qv_instance* const* group, int count, const SystemSca
 }
 
 // Evaluates the members' polynomials together at their presetAt points and leaves each one's
-// preset for its step's next evaluation there: R(q) and E(q), K(q) in its `stiffness`; returns
-// the group's K packed by lane (evaluateLanes()) in `scratch`.
+// preset for its step's next evaluation there: R(q) and E(q), K(q)'s upper triangle in its
+// `stiffness` (all the minimiser reads); returns the group's K packed by lane (evaluateLanes()) in
+// `scratch`.
 QV_HOT double* evaluateTogether(qv_instance* const* members, int count, double* scratch) {
   const int r = members[0]->r;
   double* stiffnessLanes = scratch;  // [pair][lane]
@@ -97,9 +98,7 @@ QV_HOT double* evaluateTogether(qv_instance* const* members, int count, double* 
   }
   members[0]->model->polynomial.evaluateLanes(at, count, energy, force, stiffnessLanes, scratch + pairs(r) * kLanes);
   unpackUpper(stiffnessLanes, r, count, stiffness);
-  for (int l = 0; l < count; ++l) {  // the lower half, within each member's own matrix
-    for (int a = 0; a < r; ++a)
-      for (int b = a + 1; b < r; ++b) stiffness[l][b * r + a] = stiffness[l][a * r + b];
+  for (int l = 0; l < count; ++l) {
     members[l]->work.presetEnergy = energy[l];
     members[l]->work.presetValid = true;
   }
@@ -122,6 +121,12 @@ void stepNewtonGroup(qv_instance* const* group, const int* index, int count, dou
     scales[l] = newtonSystem(*group[l], c1, c2);
   }
   factoriseGroup(group, count, scales, evaluateTogether(group, count, scratch));
+  for (int l = 0; l < count; ++l) {  // K's lower half too: damping and the LU fallback read whole rows
+    double* K = group[l]->work.stiffness;
+    const int r = group[l]->r;
+    for (int a = 0; a < r; ++a)
+      for (int b = a + 1; b < r; ++b) K[b * r + a] = K[a * r + b];
+  }
   for (int l = 0; l < count; ++l) {
     const qv_step_status status = group[l]->finishStep();
     if (statuses) statuses[index[l]] = status;
@@ -189,9 +194,10 @@ namespace {
 bool minimizing(const qv_instance& s) { return s.config.solver == QV_SOLVER_MINIMIZE; }
 
 // Steps instances [first, last). The groupable ones are stepped together: fixed Newton steps in
-// groups of kLanes in order, minimising steps in lock step; the others alone. So that the same
-// instances are evaluated together whatever the jobs, a groupable instance that would be alone in
-// the last group of kLanes is stepped alone (the one-state evaluation is the faster).
+// groups of kLanes in order, minimising steps in lock step; the others alone. When the range's
+// groupable instances number one more than a multiple of kLanes, the last of them is stepped alone
+// (for a lone instance the one-state evaluation is the faster); ranges are cut on multiples of
+// kLanes instances, so in a crowd of groupable instances that is the same instance whatever the jobs.
 void stepRange(qv_instance* const* instances, int first, int last, double* scratch, qv_step_status* statuses) {
   int groupableCount = 0, lone = -1;
   for (int i = first; i < last; ++i)

@@ -1,9 +1,9 @@
 #pragma once
-// Many instances of one model stepped in one call (qv_instances_step): groups of up to
-// ReducedPolynomial::kLanes St.Venant-Kirchhoff Newmark instances evaluate their first guess
-// together (each coefficient read once per group, SIMD across the group), then each finishes its
-// step as qv_instance_step would. The work is cut into the caller's jobs; each job owns a slice of
-// the caller's scratch.
+// Many instances of one model stepped in one call (qv_instances_step): St.Venant-Kirchhoff Newmark
+// instances are evaluated up to ReducedPolynomial::kLanes at a time (each coefficient read once for
+// them, SIMD across them) and their Newton matrices factorised together; each step otherwise runs
+// as qv_instance_step would run it (docs/architecture.md, "Many instances"). The work is cut into
+// the caller's jobs; each job owns a slice of the caller's scratch.
 #include "instance.h"
 
 namespace quiver::rt {

@@ -179,7 +179,6 @@ TEST_P(BakeStages, BothSolversMatchTheDenseSolveOnAFinerBar) {
   }
 }
 
-// A fixed object's derivatives through the modes' factor of K are the ones a factor of their own gives.
 // Every rank adds every tet touching its rows, in tet order: K and M are the serial assembly's
 // bits on any rank count (and so in any run: no partial sums arrive from other ranks in message
 // order). Each rank compares its rows with an assembly of its own on MPI_COMM_SELF.
@@ -209,6 +208,10 @@ TEST(BakeStages, AssembledMatricesAreTheSerialBitsOnEveryRankCount) {
           for (PetscInt i = 0; i < count; ++i)
             serialColumns[i] = static_cast<PetscInt>(serialLayout.dof(vertexOfRow[columns[i] / 3], columns[i] % 3));
           ASSERT_EQ(MatRestoreRow(distributed, row, &n, &columns, &values), 0);
+          PetscInt serialCount = 0;
+          ASSERT_EQ(MatGetRow(reference, serialRow, &serialCount, nullptr, nullptr), 0);
+          differ += serialCount != count;  // no entry missing from the distributed row
+          ASSERT_EQ(MatRestoreRow(reference, serialRow, &serialCount, nullptr, nullptr), 0);
           ASSERT_EQ(MatGetValues(reference, 1, &serialRow, count, serialColumns.data(), theirs.data()), 0);
           for (PetscInt i = 0; i < count; ++i) differ += mine[i] != theirs[i];
           compared += count;
@@ -218,6 +221,7 @@ TEST(BakeStages, AssembledMatricesAreTheSerialBitsOnEveryRankCount) {
   }
 }
 
+// A fixed object's derivatives through the modes' factor of K are the ones a factor of their own gives.
 TEST(BakeStages, DerivativesThroughTheSharedFactorAreTheSame) {
   Problem p(false);
   StiffnessFactor shared(p.system.stiffness, *p.layout);

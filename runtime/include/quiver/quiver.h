@@ -230,9 +230,11 @@ QV_API void qv_instance_last_step(const qv_instance* instance, qv_step_report* r
 /* Many instances of one model in one call: each is stepped as qv_instance_step() would step it,
    but implicit Newmark St.Venant-Kirchhoff instances are evaluated 8 at a time: each coefficient
    is read once for the 8 and multiplies their states at once (SIMD across instances), and their
-   Newton matrices are factorised 8 at a time. QV_SOLVER_NEWTON steps go in groups of 8 (the first
-   guess's evaluation and matrix: the whole of a one-iteration step but its substitution);
-   QV_SOLVER_MINIMIZE steps run up to 8 in lock step, every evaluation of each shared. The sums run in another
+   Newton matrices are factorised 8 at a time (not in free flight, where they depend on the state).
+   QV_SOLVER_NEWTON steps go in groups of 8 (the first guess's evaluation and matrix: the whole of
+   a one-iteration step but its substitution); QV_SOLVER_MINIMIZE steps run up to 8 in lock step,
+   sharing every evaluation of their iterations and line searches (the energy budget's rare
+   draw-back evaluates alone). The sums run in another
    order than one instance's, so states agree with qv_instance_step() to rounding, not bit for bit
    (docs/architecture.md, "Many instances"); they do not depend on the number of jobs when every
    instance is groupable. Do not pass instances that are in a qv_world: the world steps them.

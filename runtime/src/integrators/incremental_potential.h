@@ -16,6 +16,8 @@
 // nonlinear model; without the slack the budget would damp it), less what damping dissipates. What the integrator would add beyond
 // it is taken out of the velocity (qv_step_report::energy_removed). So without loads and damping H
 // never exceeds its first value, and under bounded loads the state stays bounded.
+#include <cmath>
+
 #include "../instance.h"
 
 namespace quiver::rt {
@@ -29,9 +31,10 @@ struct StepPredictor {
 // (C0 v)_i, C0 = alpha I + beta K(0).
 double restDampingForce(const qv_instance& s, int i, const double* v);
 
-// Phi's Hessian w I + K(x) + J + s C0, the matrix of each Newton direction (before any shift).
+// Phi's Hessian w I + K(x) + J + s C0, the matrix of each Newton direction (before any shift);
+// fused explicitly, as newtonSystem() (dynamics.h).
 inline SystemScales minimizerSystem(const qv_instance& s, const StepPredictor& p) {
-  return {1.0, 1.0, p.s * s.config.rayleigh_beta, p.w + p.s * s.config.rayleigh_alpha};
+  return {1.0, 1.0, p.s * s.config.rayleigh_beta, std::fma(p.s, s.config.rayleigh_alpha, p.w)};
 }
 
 // Phi at one iterate, the force scale of its convergence test and the state forces' Jacobian.
