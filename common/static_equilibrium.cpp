@@ -84,7 +84,8 @@ Eigen::VectorXd minimize(Energy& energy, Eigen::VectorXd x, ToU toU, Pull pull, 
 } // namespace
 
 Eigen::VectorXd solveStatic(const StVKForceModel& model, const std::vector<Eigen::Vector3d>& rest,
-                            const std::vector<int>& fixed, const StaticLoad& load, const StaticSettings& settings) {
+                            const std::vector<int>& fixed, const StaticLoad& load, const StaticSettings& settings,
+                            const SymmetricSolve& solve) {
   const int n = model.dofCount();
   std::vector<char> isFixed(n, 0);
   for (int v : fixed)
@@ -106,6 +107,18 @@ Eigen::VectorXd solveStatic(const StVKForceModel& model, const std::vector<Eigen
   // The Hessian's pattern never changes (K's, the springs' diagonal): order it once.
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
   bool analyzed = false;
+  const SymmetricSolve simplicial = [&](const Eigen::SparseMatrix<double>& H, const Eigen::VectorXd& b,
+                                        Eigen::VectorXd& x) {
+    if (!analyzed) {
+      ldlt.analyzePattern(H);
+      analyzed = true;
+    }
+    ldlt.factorize(H);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) return false;
+    x = ldlt.solve(b);
+    return true;
+  };
+  const SymmetricSolve& solver = solve ? solve : simplicial;
   const auto direction = [&](const Eigen::VectorXd& u, const Eigen::VectorXd& g) {
     Eigen::SparseMatrix<double> H = energy.hessian(u);
     std::vector<int> index(n, -1);
@@ -122,13 +135,9 @@ Eigen::VectorXd solveStatic(const StVKForceModel& model, const std::vector<Eigen
     Hf.setFromTriplets(entries.begin(), entries.end());
     Eigen::SparseMatrix<double> I(Hf.rows(), Hf.cols());
     I.setIdentity();
-    if (!analyzed) {
-      ldlt.analyzePattern(Hf);
-      analyzed = true;
-    }
+    Eigen::VectorXd d;
     for (double mu = 0;; mu = mu > 0 ? 10 * mu : 1e-8 * largest) {
-      ldlt.factorize(Hf + mu * I);
-      if (ldlt.info() == Eigen::Success && ldlt.vectorD().minCoeff() > 0) return Eigen::VectorXd(ldlt.solve(-g));
+      if (solver(Hf + mu * I, -g, d)) return d;
       if (mu > 1e6 * largest) throw std::runtime_error("static equilibrium: the Hessian cannot be made positive definite");
     }
   };

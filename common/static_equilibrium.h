@@ -7,9 +7,11 @@
 // reached along their path, not jumped to). The subspace version works on E(U q) itself: it is the
 // baked reduced model's energy exactly, without its polynomial, so comparing the two solutions
 // measures what the basis loses and nothing else (the bake's fidelity report).
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 #include "common/stvk_force_model.h"
 
@@ -29,10 +31,17 @@ struct StaticSettings {
   double accepted = 1e-6;    // an increment that ends within this (rounding) still counts as converged
 };
 
-// Full space: `fixed` vertices stay at rest. Throws std::runtime_error when an increment does not
-// converge (the message says which and how far).
+// Solves H x = b for the free DOFs' symmetric Hessian H (whole, free DOFs in vertex order, three
+// per vertex), or returns false when H is not positive definite. Each Newton step calls it with
+// the same pattern.
+using SymmetricSolve = std::function<bool(const Eigen::SparseMatrix<double>& H, const Eigen::VectorXd& b, Eigen::VectorXd& x)>;
+
+// Full space: `fixed` vertices stay at rest. `solve` by default Eigen's SimplicialLDLT (its order
+// computed once); the bake passes a faster one. Throws std::runtime_error when an increment does
+// not converge (the message says which and how far).
 Eigen::VectorXd solveStatic(const StVKForceModel& model, const std::vector<Eigen::Vector3d>& rest,
-                            const std::vector<int>& fixed, const StaticLoad& load, const StaticSettings& settings = {});
+                            const std::vector<int>& fixed, const StaticLoad& load, const StaticSettings& settings = {},
+                            const SymmetricSolve& solve = {});
 
 // Subspace: the equilibrium among u = U q (U: 3n x r, zero rows at fixed DOFs); returns U q.
 Eigen::VectorXd solveStaticReduced(const StVKForceModel& model, const std::vector<Eigen::Vector3d>& rest,

@@ -118,8 +118,8 @@ SequentialCholesky::UpperTriangle SequentialCholesky::upperTriangle(Mat A) {
   return upper;
 }
 
-SequentialCholesky::SequentialCholesky(UpperTriangle upper, PetscInt schurSize)
-    : mumps_(std::make_unique<Mumps>()), rows_(upper.n), schurSize_(schurSize) {
+SequentialCholesky::SequentialCholesky(UpperTriangle upper, PetscInt schurSize, bool refactorable)
+    : mumps_(std::make_unique<Mumps>()), rows_(upper.n), schurSize_(schurSize), refactorable_(refactorable) {
   const PetscInt n = upper.n;
   if (n > INT_MAX) throw std::runtime_error("SequentialCholesky: " + std::to_string(n) + " rows exceed MUMPS's int");
   if (schurSize < 0 || schurSize >= n)
@@ -184,6 +184,18 @@ SequentialCholesky::SequentialCholesky(UpperTriangle upper, PetscInt schurSize)
   if (id.infog[0] < 0) throw std::runtime_error(mumpsError(id, "analysis"));
   std::vector<MUMPS_INT>().swap(m.perm);  // read by the analysis only
   id.perm_in = nullptr;
+  factor();
+  // The solves read the matrix only to refine or analyse errors.
+  if (!refactorable && icntl(id, 10) == 0 && icntl(id, 11) == 0) {
+    m.upper = UpperTriangle();
+    id.irn = id.jcn = nullptr;
+    id.a = nullptr;
+  }
+}
+
+void SequentialCholesky::factor() {
+  Mumps& m = *mumps_;
+  DMUMPS_STRUC_C& id = m.id;
   id.job = kFactor;
   {
     static const PetscLogEvent event = registerLogEvent("Sequential Cholesky", "SeqCholFactor");  // a -log_view row
@@ -192,16 +204,26 @@ SequentialCholesky::SequentialCholesky(UpperTriangle upper, PetscInt schurSize)
   }
   if (id.infog[0] < 0) throw std::runtime_error(mumpsError(id, "factorization"));
   if (id.infog[11] > 0)
-    throw std::runtime_error("the matrix to factor is not positive definite: " + std::to_string(id.infog[11]) +
-                             " negative pivots in its Cholesky factorization");
-  if (icntl(id, 10) == 0 && icntl(id, 11) == 0) {  // the solves read the matrix only to refine or analyse errors
-    m.upper = UpperTriangle();
-    id.irn = id.jcn = nullptr;
-    id.a = nullptr;
-  }
+    throw NotPositiveDefinite("the matrix to factor is not positive definite: " + std::to_string(id.infog[11]) +
+                              " negative pivots in its Cholesky factorization");
   // MUMPS returns the symmetric Schur complement's lower triangle by rows, the upper one column-major;
   // what it leaves in the other triangle varies (all of it for small complements, zeros for large).
-  if (schurSize > 0) m.schur.triangularView<Eigen::StrictlyLower>() = m.schur.transpose();
+  if (schurSize_ > 0) m.schur.triangularView<Eigen::StrictlyLower>() = m.schur.transpose();
+}
+
+void SequentialCholesky::refactor(const std::vector<double>& values) {
+  Mumps& m = *mumps_;
+  if (!refactorable_) throw std::logic_error("SequentialCholesky: refactor() needs a factor made refactorable");
+  if (values.size() != m.upper.values.size())
+    throw std::logic_error("SequentialCholesky: refactor() with " + std::to_string(values.size()) + " values for " +
+                           std::to_string(m.upper.values.size()) + " entries");
+  m.upper.values = values;
+  m.id.a = m.upper.values.data();
+  if (schurSize_ > 0) {  // into a fresh complement: the last one may have been taken
+    m.schur.setZero(schurSize_, schurSize_);
+    m.id.schur = m.schur.data();
+  }
+  factor();
 }
 
 SequentialCholesky::~SequentialCholesky() = default;

@@ -11,12 +11,18 @@
 // -factor_mat_mumps_icntl_<i> and -factor_mat_mumps_cntl_<i>; -factor_mat_mumps_icntl_7 chooses
 // one of MUMPS's own orderings instead of METIS.
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include <Eigen/Core>
 #include <petscmat.h>
 
 namespace quiver {
+
+// What SequentialCholesky throws when the matrix has negative pivots.
+struct NotPositiveDefinite : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 class SequentialCholesky {
 public:
@@ -31,12 +37,18 @@ public:
 
   // Factors the matrix, whose last `schurSize` variables stay out of the factor: for
   // [A_II A_IS; A_SI A_SS] it factors A_II and forms the Schur complement A_SS - A_SI A_II^-1 A_IS
-  // (schurComplement()). Throws std::runtime_error naming MUMPS's error, or the count of negative
-  // pivots when the matrix (A_II) is not positive definite.
-  explicit SequentialCholesky(UpperTriangle upper, PetscInt schurSize = 0);
+  // (schurComplement()). Throws std::runtime_error naming MUMPS's error, or NotPositiveDefinite
+  // with the count of negative pivots when the matrix (A_II) is not positive definite.
+  // `refactorable` keeps the pattern (its rows and columns) for refactor().
+  explicit SequentialCholesky(UpperTriangle upper, PetscInt schurSize = 0, bool refactorable = false);
   ~SequentialCholesky();
   SequentialCholesky(const SequentialCholesky&) = delete;
   SequentialCholesky& operator=(const SequentialCholesky&) = delete;
+
+  // Factors a matrix of the same pattern anew: `values` in the order of the UpperTriangle's entries,
+  // with the order and analysis of the first (Newton's Hessians change their values only). Throws
+  // as the constructor does; after a throw, refactor() may be called again.
+  void refactor(const std::vector<double>& values);
 
   // Without Schur variables: overwrites `columns` (column-major, rows() rows) with A^-1 columns.
   void solveInPlace(double* columns, PetscInt count) const;
@@ -54,9 +66,11 @@ public:
 
 private:
   struct Mumps;
+  void factor();
   void solvePhase(double* columns, PetscInt count, int condensation, double* reduced) const;
   std::unique_ptr<Mumps> mumps_;
   PetscInt rows_ = 0, schurSize_ = 0;
+  bool refactorable_ = false;
 };
 
 } // namespace quiver

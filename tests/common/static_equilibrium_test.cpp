@@ -108,3 +108,25 @@ TEST(StaticEquilibrium, TheSubspaceSolverOnEveryFreeDofIsTheFullSolver) {
                         std::atan2((c.mesh.vertices[c.tip.back()] - centre).z(), (c.mesh.vertices[c.tip.back()] - centre).y());
   EXPECT_GT(turned, 0.7 * M_PI / 6);
 }
+
+// The bake passes its own solver for the Newton systems: a dense one here gives the same
+// equilibrium as the default simplicial LDLT, and is the one used.
+TEST(StaticEquilibrium, AGivenSolverIsUsedForTheNewtonSystems) {
+  Cantilever c;
+  const StVKForceModel model(c.mesh, c.perTet);
+  StaticLoad load;
+  load.force = c.weight(9.81);
+  int calls = 0;
+  const SymmetricSolve dense = [&](const Eigen::SparseMatrix<double>& H, const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+    ++calls;
+    const Eigen::LLT<Eigen::MatrixXd> llt{Eigen::MatrixXd(H)};
+    if (llt.info() != Eigen::Success) return false;
+    x = llt.solve(b);
+    return true;
+  };
+  const Eigen::VectorXd simplicial = solveStatic(model, c.mesh.vertices, c.fixed, load);
+  const Eigen::VectorXd given = solveStatic(model, c.mesh.vertices, c.fixed, load, {}, dense);
+  EXPECT_GT(calls, 0);
+  EXPECT_LT((given - simplicial).norm(), 1e-8 * simplicial.norm());
+  EXPECT_GT(simplicial.norm(), 0.1);
+}

@@ -105,6 +105,45 @@ TEST(SequentialCholesky, RefusesAnIndefiniteMatrix) {
   }
 }
 
+// A factor kept refactorable takes new values on the same pattern (the order and analysis of the
+// first): each solves like a dense factor of its own matrix; an indefinite one is refused and the
+// next one factors again.
+TEST(SequentialCholesky, RefactorsNewValuesOnTheSamePattern) {
+  const Eigen::MatrixXd A = gridMatrix(5, 4, 3, 3, 0, 0.5);
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> noise(-0.2, 0.2);
+  Eigen::MatrixXd B = A;
+  for (Eigen::Index i = 0; i < B.rows(); ++i)
+    for (Eigen::Index j = i; j < B.cols(); ++j)
+      if (A(i, j) != 0) B(i, j) = B(j, i) = A(i, j) * (1 + noise(random));
+  B.diagonal().array() += 1.0;  // kept positive definite
+  Eigen::MatrixXd indefinite = B;
+  indefinite.diagonal().array() -= 20.0;
+  ASSERT_LT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(indefinite).eigenvalues()[0], 0);
+  const auto valuesOf = [&](const Eigen::MatrixXd& M) {  // in the order of A's upper triangle
+    std::vector<double> values;
+    const SequentialCholesky::UpperTriangle pattern = SequentialCholesky::upperTriangle(petscMatrix(A));
+    for (size_t e = 0; e < pattern.rows.size(); ++e) values.push_back(M(pattern.rows[e], pattern.cols[e]));
+    return values;
+  };
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(A.rows(), -1.0, 2.0);
+  const auto solve = [&](const SequentialCholesky& factor) {
+    Eigen::VectorXd x = b;
+    factor.solveInPlace(x.data(), 1);
+    return x;
+  };
+  SequentialCholesky factor(SequentialCholesky::upperTriangle(petscMatrix(A)), 0, true);
+  EXPECT_LT((solve(factor) - A.llt().solve(b)).norm(), 1e-12 * b.norm());
+  factor.refactor(valuesOf(B));
+  EXPECT_LT((solve(factor) - B.llt().solve(b)).norm(), 1e-12 * b.norm());
+  EXPECT_THROW(factor.refactor(valuesOf(indefinite)), NotPositiveDefinite);
+  factor.refactor(valuesOf(A));
+  EXPECT_LT((solve(factor) - A.llt().solve(b)).norm(), 1e-12 * b.norm());
+  EXPECT_THROW(factor.refactor(std::vector<double>(3, 1.0)), std::logic_error);
+  SequentialCholesky once(SequentialCholesky::upperTriangle(petscMatrix(A)));
+  EXPECT_THROW(once.refactor(valuesOf(B)), std::logic_error);
+}
+
 // With the last variables left out: the Schur complement a dense elimination gives, and condense,
 // a dense solve on the Schur variables and expand together solve the whole system. A small Schur
 // block, and a large one with no entries of its own (as SplitCholesky gives it): MUMPS returns the
