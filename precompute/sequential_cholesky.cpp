@@ -196,12 +196,15 @@ SequentialCholesky::SequentialCholesky(UpperTriangle upper, PetscInt schurSize, 
 void SequentialCholesky::factor() {
   Mumps& m = *mumps_;
   DMUMPS_STRUC_C& id = m.id;
+  factored_ = false;
   id.job = kFactor;
   {
     static const PetscLogEvent event = registerLogEvent("Sequential Cholesky", "SeqCholFactor");  // a -log_view row
     const LogEventScope timed(event);
     dmumps_c(&id);
   }
+  if (id.infog[0] == -10)  // a zero pivot: singular, so not positive definite either
+    throw NotPositiveDefinite("the matrix to factor is not positive definite: " + mumpsError(id, "factorization"));
   if (id.infog[0] < 0) throw std::runtime_error(mumpsError(id, "factorization"));
   if (id.infog[11] > 0)
     throw NotPositiveDefinite("the matrix to factor is not positive definite: " + std::to_string(id.infog[11]) +
@@ -209,6 +212,7 @@ void SequentialCholesky::factor() {
   // MUMPS returns the symmetric Schur complement's lower triangle by rows, the upper one column-major;
   // what it leaves in the other triangle varies (all of it for small complements, zeros for large).
   if (schurSize_ > 0) m.schur.triangularView<Eigen::StrictlyLower>() = m.schur.transpose();
+  factored_ = true;
 }
 
 void SequentialCholesky::refactor(const std::vector<double>& values) {
@@ -231,11 +235,13 @@ SequentialCholesky::~SequentialCholesky() = default;
 int SequentialCholesky::orderingUsed() const { return mumps_->id.infog[6]; }
 
 Eigen::MatrixXd SequentialCholesky::takeSchurComplement() {
+  if (!factored_) throw std::logic_error("SequentialCholesky: no Schur complement (the last refactor() failed)");
   mumps_->id.schur = nullptr;
   return std::move(mumps_->schur);
 }
 
 void SequentialCholesky::solvePhase(double* columns, PetscInt count, int condensation, double* reduced) const {
+  if (!factored_) throw std::logic_error("SequentialCholesky: no factor to solve with (the last refactor() failed)");
   if (count <= 0) return;
   if (count > INT_MAX) throw std::runtime_error("SequentialCholesky: too many right-hand sides for one solve");
   DMUMPS_STRUC_C& id = mumps_->id;

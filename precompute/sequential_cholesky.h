@@ -1,7 +1,8 @@
 #pragma once
 // A sparse Cholesky factorization of a symmetric positive definite matrix on this rank, optionally
 // leaving out a set of variables whose Schur complement it forms (DirectSolver splits a matrix
-// between ranks that way): MUMPS called directly (sequential, on MPI_COMM_SELF) in a METIS
+// between ranks that way), or factored anew with new values (the fidelity stage's Newton
+// systems): MUMPS called directly (sequential, on MPI_COMM_SELF) in a METIS
 // nested-dissection order of the matrix's vertex graph (blocks of three DOFs). Debian's MUMPS has
 // no METIS of its own and falls back to PORD: on the 97k-tet torus of bench/torus_bake.py the METIS
 // order has 12% fewer factor entries and 28% fewer flops (order and factor 1.22 s against 1.37 s
@@ -19,7 +20,7 @@
 
 namespace quiver {
 
-// What SequentialCholesky throws when the matrix has negative pivots.
+// What SequentialCholesky throws when the matrix has negative or zero pivots.
 struct NotPositiveDefinite : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
@@ -37,8 +38,8 @@ public:
 
   // Factors the matrix, whose last `schurSize` variables stay out of the factor: for
   // [A_II A_IS; A_SI A_SS] it factors A_II and forms the Schur complement A_SS - A_SI A_II^-1 A_IS
-  // (schurComplement()). Throws std::runtime_error naming MUMPS's error, or NotPositiveDefinite
-  // with the count of negative pivots when the matrix (A_II) is not positive definite.
+  // (takeSchurComplement()). Throws std::runtime_error naming MUMPS's error, or NotPositiveDefinite
+  // when the matrix (A_II) is not positive definite (negative pivots, counted, or a zero one).
   // `refactorable` keeps the pattern (its rows and columns) for refactor().
   explicit SequentialCholesky(UpperTriangle upper, PetscInt schurSize = 0, bool refactorable = false);
   ~SequentialCholesky();
@@ -47,7 +48,8 @@ public:
 
   // Factors a matrix of the same pattern anew: `values` in the order of the UpperTriangle's entries,
   // with the order and analysis of the first (Newton's Hessians change their values only). Throws
-  // as the constructor does; after a throw, refactor() may be called again.
+  // as the constructor does; after a throw, refactor() may be called again, but nothing solves
+  // until one succeeds.
   void refactor(const std::vector<double>& values);
 
   // Without Schur variables: overwrites `columns` (column-major, rows() rows) with A^-1 columns.
@@ -70,7 +72,7 @@ private:
   void solvePhase(double* columns, PetscInt count, int condensation, double* reduced) const;
   std::unique_ptr<Mumps> mumps_;
   PetscInt rows_ = 0, schurSize_ = 0;
-  bool refactorable_ = false;
+  bool refactorable_ = false, factored_ = false;
 };
 
 } // namespace quiver

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 #include <functional>
 #include <memory>
 
@@ -77,15 +78,27 @@ std::vector<std::pair<std::string, StaticLoad>> loadCases(const MeshInputs& in) 
   return cases;
 }
 
+// A MUMPS failure other than an indefinite matrix (memory, workspace): the bake stops with it
+// rather than reporting the load case as one without an equilibrium.
+struct SolverFailure : std::exception {
+  explicit SolverFailure(std::string text) : message(std::move(text)) {}
+  const char* what() const noexcept override { return message.c_str(); }
+  std::string message;
+};
+
 // The full-space Newton systems through MUMPS in a METIS order (sequential_cholesky.h), ordered and
-// analysed once per equilibrium (the Hessian's pattern never changes), then factored anew with each
-// Hessian's values. On the 12.8k-tet bridge Eigen's simplicial LDLT took most of this stage's 12 s
-// (165 factorisations), and MUMPS ordering and analysing each one anew was no faster.
+// analysed once per equilibrium (the Hessian's pattern never changes; checked), then factored anew
+// with each Hessian's values. On the 12.8k-tet bridge Eigen's simplicial LDLT took most of this
+// stage's 12 s (165 factorisations), and MUMPS ordering and analysing each one anew was no faster.
 class MumpsSolve {
 public:
   bool operator()(const Eigen::SparseMatrix<double>& H, const Eigen::VectorXd& b, Eigen::VectorXd& x) {
     SequentialCholesky::UpperTriangle upper;
     upper.n = static_cast<PetscInt>(H.rows());
+    const size_t entries = static_cast<size_t>(H.nonZeros() + H.rows()) / 2;
+    upper.rows.reserve(entries);
+    upper.cols.reserve(entries);
+    upper.values.reserve(entries);
     for (int col = 0; col < H.outerSize(); ++col)
       for (Eigen::SparseMatrix<double>::InnerIterator it(H, col); it; ++it)
         if (it.row() <= col) {
@@ -94,24 +107,27 @@ public:
           upper.values.push_back(it.value());
         }
     try {
-      if (factor_ && entries_ == upper.values.size()) {
+      if (factor_ && upper.rows == rows_ && upper.cols == cols_) {
         factor_->refactor(upper.values);
       } else {
         factor_.reset();
-        entries_ = upper.values.size();
+        rows_ = upper.rows;
+        cols_ = upper.cols;
         factor_ = std::make_unique<SequentialCholesky>(std::move(upper), 0, true);
       }
-      x = b;
-      factor_->solveInPlace(x.data(), 1);
-      return true;
     } catch (const NotPositiveDefinite&) {
       return false;
+    } catch (const std::runtime_error& e) {
+      throw SolverFailure(std::string("fidelity: ") + e.what());
     }
+    x = b;
+    factor_->solveInPlace(x.data(), 1);
+    return true;
   }
 
 private:
   std::unique_ptr<SequentialCholesky> factor_;
-  size_t entries_ = 0;
+  std::vector<int> rows_, cols_;  // the pattern factor_ was ordered and analysed for
 };
 
 FidelityReport measure(const MeshInputs& in, const Eigen::MatrixXd& U, const LinearModes& modes) {
@@ -131,12 +147,14 @@ FidelityReport measure(const MeshInputs& in, const Eigen::MatrixXd& U, const Lin
       // folds) is reported as not measured (NaN): the report never fails the bake.
       FidelityCase measured{name, std::nan(""), std::nan("")};
       try {
-        MumpsSolve mumps;
-        const Eigen::VectorXd full =
-            solveStatic(model, m.vertices, in.fixed, load, settings,
-                        [&mumps](const Eigen::SparseMatrix<double>& H, const Eigen::VectorXd& b, Eigen::VectorXd& x) {
-                          return mumps(H, b, x);
-                        });
+        Eigen::VectorXd full;
+        {  // the factor is freed before the reduced solve
+          MumpsSolve mumps;
+          full = solveStatic(model, m.vertices, in.fixed, load, settings,
+                             [&mumps](const Eigen::SparseMatrix<double>& H, const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+                               return mumps(H, b, x);
+                             });
+        }
         const Eigen::VectorXd reduced = solveStaticReduced(model, m.vertices, U, load, settings);
         double largest = 0;
         for (int v = 0; v < m.vertexCount(); ++v) largest = std::max(largest, full.segment<3>(3 * v).norm());

@@ -106,8 +106,8 @@ TEST(SequentialCholesky, RefusesAnIndefiniteMatrix) {
 }
 
 // A factor kept refactorable takes new values on the same pattern (the order and analysis of the
-// first): each solves like a dense factor of its own matrix; an indefinite one is refused and the
-// next one factors again.
+// first): each solves like a dense factor of its own matrix; an indefinite one is refused, nothing
+// solves until the next one factors again.
 TEST(SequentialCholesky, RefactorsNewValuesOnTheSamePattern) {
   const Eigen::MatrixXd A = gridMatrix(5, 4, 3, 3, 0, 0.5);
   std::mt19937 random(3);
@@ -137,6 +137,7 @@ TEST(SequentialCholesky, RefactorsNewValuesOnTheSamePattern) {
   factor.refactor(valuesOf(B));
   EXPECT_LT((solve(factor) - B.llt().solve(b)).norm(), 1e-12 * b.norm());
   EXPECT_THROW(factor.refactor(valuesOf(indefinite)), NotPositiveDefinite);
+  EXPECT_THROW(solve(factor), std::logic_error);  // no factor to solve with until a refactor succeeds
   factor.refactor(valuesOf(A));
   EXPECT_LT((solve(factor) - A.llt().solve(b)).norm(), 1e-12 * b.norm());
   EXPECT_THROW(factor.refactor(std::vector<double>(3, 1.0)), std::logic_error);
