@@ -32,6 +32,10 @@ double repeatFactor(const int (&idx)[N]) {
 
 size_t align8(size_t n) { return n & ~size_t(7); }
 
+// Rows padded to whole blocks (ReducedPolynomial::kBlock = 8), and where entry (i, k) of r columns sits.
+size_t blockedRows(size_t rows) { return (rows + 7) & ~size_t(7); }
+size_t blockedAt(int r, size_t i, int k) { return align8(i) * r + static_cast<size_t>(k) * 8 + (i & 7); }
+
 size_t packedCount(size_t pairs) {
   size_t total = 0;
   for (size_t p = 0; p < pairs; ++p) total += pairs - align8(p);
@@ -98,14 +102,24 @@ QV_HOT void packedSymmetricProduct(const C* Q, const size_t* rowStart, const siz
   }
 }
 
-// y += sum_k q_k T_k over the rows T_k of length n.
-QV_HOT void sumOfRows(const double* T, int r, size_t n, const double* q, double* y) {
-  for (size_t s = 0; s < n; ++s) y[s] = 0;
-  for (int k = 0; k < r; ++k) {
-    const double* row = T + k * n;
-    const double qk = q[k];
+// y[i] = sum_k B_ik q_k, k in order, over the rows of a blocked matrix (ReducedPolynomial::kBlock;
+// y has room for the last block's padding rows). Four blocks per sweep: four independent running
+// sums, where one block alone would wait on the multiply-add latency at every k.
+QV_HOT void blockedProduct(const double* B, int r, size_t rows, const double* q, double* y) {
+  constexpr size_t G = 8, N = 4;
+  const size_t stride = static_cast<size_t>(r) * G, blocks = (rows + G - 1) / G;
+  for (size_t b = 0; b < blocks; b += N) {
+    const size_t n = blocks - b < N ? blocks - b : N;
+    double sum[N][G] = {};
+    for (int k = 0; k < r; ++k) {
+      const double qk = q[k];
+      for (size_t m = 0; m < n; ++m)
 #pragma omp simd
-    for (size_t s = 0; s < n; ++s) y[s] += row[s] * qk;
+        for (size_t g = 0; g < G; ++g) sum[m][g] += B[(b + m) * stride + k * G + g] * qk;
+    }
+    for (size_t m = 0; m < n; ++m)
+#pragma omp simd
+      for (size_t g = 0; g < G; ++g) y[(b + m) * G + g] = sum[m][g];
   }
 }
 
@@ -114,13 +128,19 @@ QV_HOT void sumOfRows(const double* T, int r, size_t n, const double* q, double*
 ReducedPolynomial::Arrays ReducedPolynomial::carve(BlockCarver& c, bool single) const {
   Arrays a{};
   a.k2 = c.take<double>(pairs_);
-  a.t = c.take<double>(static_cast<size_t>(r_) * pairs_);
+  a.t = c.take<double>(static_cast<size_t>(r_) * blockedRows(pairs_));
   a.rowStart = c.take<size_t>(pairs_);
   a.rowOffset = c.take<size_t>(pairs_);
   if (single)
     a.q32 = c.take<float>(packedCount(pairs_));
   else
     a.q64 = c.take<double>(packedCount(pairs_));
+  const size_t d = static_cast<size_t>(r_) * blockedRows(triples_);
+  if (single)
+    a.d32 = c.take<float>(d);
+  else
+    a.d64 = c.take<double>(d);
+  a.tripleOf = c.take<uint32_t>(static_cast<size_t>(r_) * blockedRows(pairs_));
   return a;
 }
 
@@ -128,16 +148,20 @@ size_t ReducedPolynomial::storageBytes(int r, bool single) {
   ReducedPolynomial measured;
   measured.r_ = r;
   measured.pairs_ = monomialCount2(r);
+  measured.triples_ = monomialCount3(r);
   BlockCarver c(nullptr);
   measured.carve(c, single);
   return c.size();
 }
 
-size_t ReducedPolynomial::scratchSize(int r) { return monomialCount2(r) * 3 + static_cast<size_t>(r); }
+size_t ReducedPolynomial::scratchSize(int r) {
+  return monomialCount2(r) * 2 + blockedRows(monomialCount2(r)) + static_cast<size_t>(r);
+}
 
 void ReducedPolynomial::build(int r, const double* c, bool single, void* storage) {
   r_ = r;
   pairs_ = monomialCount2(r);
+  triples_ = monomialCount3(r);
   const size_t P = pairs_;
   BlockCarver carver(static_cast<char*>(storage));
   const Arrays arrays = carve(carver, single);
@@ -179,7 +203,7 @@ void ReducedPolynomial::build(int r, const double* c, bool single, void* storage
         const int idx[3] = {i, j, k};
         const double T = c3[monomialIndex3(r, i, j, k)] * repeatFactor(idx);
         for (int x = 0; x < 3; ++x)
-          for (int y = x + 1; y < 3; ++y) t[idx[3 - x - y] * P + pairIndex(r, idx[x], idx[y])] = T;
+          for (int y = x + 1; y < 3; ++y) t[blockedAt(r, pairIndex(r, idx[x], idx[y]), idx[3 - x - y])] = T;
       }
   for (int i = 0; i < r; ++i)
     for (int j = i; j < r; ++j)
@@ -194,9 +218,29 @@ void ReducedPolynomial::build(int r, const double* c, bool single, void* storage
                 if (s != x && s != y) rest[n++] = idx[s];
               setQ(pairIndex(r, idx[x], idx[y]), pairIndex(r, rest[0], rest[1]), value);
             }
+          // Row (the triple left) and column (the index taken out) of the two-pass rows.
+          for (int x = 0; x < 4; ++x) {
+            int rest[3], n = 0;
+            for (int s = 0; s < 4; ++s)
+              if (s != x) rest[n++] = idx[s];
+            const size_t at = blockedAt(r, monomialIndex3(r, rest[0], rest[1], rest[2]), idx[x]);
+            if (single)
+              arrays.d32[at] = static_cast<float>(value / 2);
+            else
+              arrays.d64[at] = value / 2;
+          }
         }
+  for (int a = 0, p = 0; a < r; ++a)
+    for (int b = a; b < r; ++b, ++p)
+      for (int k = 0; k < r; ++k) {
+        const int lo = k < a ? k : a, mid = k < a ? a : (k < b ? k : b), hi = k < b ? b : k;
+        arrays.tripleOf[blockedAt(r, p, k)] = static_cast<uint32_t>(monomialIndex3(r, lo, mid, hi));
+      }
   k2_ = arrays.k2;
   t_ = arrays.t;
+  d64_ = arrays.d64;
+  d32_ = arrays.d32;
+  tripleOf_ = arrays.tripleOf;
   rowStart_ = arrays.rowStart;
   rowOffset_ = arrays.rowOffset;
   q64_ = arrays.q64;
@@ -207,17 +251,17 @@ void ReducedPolynomial::evaluate(const double* q, double* energy, double* force,
                                  double* scratch) const {
   const int r = r_;
   const size_t P = pairs_;
-  double* x = scratch;       // w_kl q_k q_l
-  double* y3 = x + P;        // K_3(q) per pair
-  double* y4 = y3 + P;       // K_4(q) per pair
-  double* Rq = y4 + P;       // r
+  double* x = scratch;               // w_kl q_k q_l
+  double* y3 = x + P;                // K_3(q) per pair
+  double* y4 = y3 + blockedRows(P);  // K_4(q) per pair
+  double* Rq = y4 + P;               // r
   for (int k = 0, s = 0; k < r; ++k)
     for (int l = k; l < r; ++l) x[s++] = (k == l ? 0.5 : 1.0) * q[k] * q[l];
   if (q32_)
     packedSymmetricProduct(q32_, rowStart_, rowOffset_, P, x, y4);
   else
     packedSymmetricProduct(q64_, rowStart_, rowOffset_, P, x, y4);
-  sumOfRows(t_, r, P, q, y3);
+  blockedProduct(t_, r, P, q, y3);
   for (int i = 0; i < r; ++i) Rq[i] = 0;
   double e = 0;
   for (int a = 0, p = 0; a < r; ++a)

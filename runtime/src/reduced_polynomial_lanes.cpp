@@ -4,6 +4,7 @@
 #include "reduced_polynomial.h"
 
 #include <cstring>
+#include <type_traits>
 
 #include "formats/model/qvr.h"
 #include "simd_dispatch.h"
@@ -14,118 +15,104 @@ namespace {
 
 constexpr int L = ReducedPolynomial::kLanes;
 
-// y[s] += Q[p][s] x[p] for s > p and y[p] += Q[p][s] x[s], as packedSymmetricProduct() does for
-// one state, here four rows of one 8-aligned group per sweep (they share their first column).
+// Where entry (i, k) of r columns sits in a blocked layout (ReducedPolynomial::kBlock).
+size_t blockedAt(int r, size_t i, int k) { return (i & ~size_t(7)) * r + static_cast<size_t>(k) * 8 + (i & 7); }
+
+// y[i] = sum_k B_ik q_k for the rows of a blocked matrix (ReducedPolynomial::kBlock): eight rows
+// per sweep, each coefficient broadcast against q_k's lanes into one of eight running sums. y has
+// room for the padding rows of the last block. float32 blocks are converted first into `block64`
+// (r kBlock doubles): converted one by one in the loop, each would cost two more instructions
+// per multiply-add.
 template <class C>
-QV_HOT void packedSymmetricProductLanes(const C* Q, const size_t* rowStart, const size_t* rowOffset, size_t n,
-                                        const double* x, double* y) {
-  std::memset(y, 0, sizeof(double) * n * L);
-  size_t p = 0;
-  for (; p + 4 <= n; p += 4) {
-    const size_t start = rowStart[p];
-    const C* r0 = Q + rowOffset[p] - start;
-    const C* r1 = Q + rowOffset[p + 1] - start;
-    const C* r2 = Q + rowOffset[p + 2] - start;
-    const C* r3 = Q + rowOffset[p + 3] - start;
-    double x0[L], x1[L], x2[L], x3[L], d0[L], d1[L], d2[L], d3[L];
-    for (int l = 0; l < L; ++l) {
-      x0[l] = x[p * L + l];
-      x1[l] = x[(p + 1) * L + l];
-      x2[l] = x[(p + 2) * L + l];
-      x3[l] = x[(p + 3) * L + l];
-      d0[l] = d1[l] = d2[l] = d3[l] = 0;
-    }
-    for (size_t s = start; s < n; ++s) {
-      const double c0 = static_cast<double>(r0[s]), c1 = static_cast<double>(r1[s]);
-      const double c2 = static_cast<double>(r2[s]), c3 = static_cast<double>(r3[s]);
-      const double* xs = x + s * L;
-      double* ys = y + s * L;
+QV_HOT void blockedProductLanes(const C* B, int r, size_t rows, const double* q, double* y, double* block64) {
+  constexpr size_t G = 8;
+  for (size_t i = 0; i < rows; i += G) {
+    const double* block;
+    if constexpr (std::is_same_v<C, double>) {
+      block = B + i * r;
+    } else {
 #pragma omp simd
-      for (int l = 0; l < L; ++l) {
-        d0[l] += c0 * xs[l];
-        d1[l] += c1 * xs[l];
-        d2[l] += c2 * xs[l];
-        d3[l] += c3 * xs[l];
-        ys[l] += c0 * x0[l] + c1 * x1[l] + c2 * x2[l] + c3 * x3[l];
-      }
+      for (size_t j = 0; j < r * G; ++j) block64[j] = static_cast<double>(B[i * r + j]);
+      block = block64;
     }
-    for (int l = 0; l < L; ++l) {
-      y[p * L + l] += d0[l];
-      y[(p + 1) * L + l] += d1[l];
-      y[(p + 2) * L + l] += d2[l];
-      y[(p + 3) * L + l] += d3[l];
-    }
-  }
-  for (; p < n; ++p) {
-    const C* row = Q + rowOffset[p] - rowStart[p];
-    double xp[L], dot[L];
-    for (int l = 0; l < L; ++l) {
-      xp[l] = x[p * L + l];
-      dot[l] = 0;
-    }
-    for (size_t s = rowStart[p]; s < n; ++s) {
-      const double c = static_cast<double>(row[s]);
+    double sum[G][L];  // set at k = 0: zeroing it first costs a memset per block
+    for (size_t g = 0; g < G; ++g)
 #pragma omp simd
-      for (int l = 0; l < L; ++l) {
-        dot[l] += c * x[s * L + l];
-        y[s * L + l] += c * xp[l];
-      }
+      for (int l = 0; l < L; ++l) sum[g][l] = block[g] * q[l];
+    for (int k = 1; k < r; ++k) {
+      const double* qk = q + k * L;
+      for (size_t g = 0; g < G; ++g)
+#pragma omp simd
+        for (int l = 0; l < L; ++l) sum[g][l] += block[k * G + g] * qk[l];
     }
-    for (int l = 0; l < L; ++l) y[p * L + l] += dot[l];
+    for (size_t g = 0; g < G; ++g)
+#pragma omp simd
+      for (int l = 0; l < L; ++l) y[(i + g) * L + l] = sum[g][l];
   }
 }
 
-// y[s] = sum_k q_k T_k[s] over the rows T_k of length n, four rows per sweep.
-QV_HOT void sumOfRowsLanes(const double* T, int r, size_t n, const double* q, double* y) {
-  std::memset(y, 0, sizeof(double) * n * L);
-  int k = 0;
-  for (; k + 4 <= r; k += 4) {
-    const double *t0 = T + k * n, *t1 = t0 + n, *t2 = t1 + n, *t3 = t2 + n;
-    const double *q0 = q + k * L, *q1 = q0 + L, *q2 = q1 + L, *q3 = q2 + L;
-    for (size_t s = 0; s < n; ++s) {
-      const double c0 = t0[s], c1 = t1[s], c2 = t2[s], c3 = t3[s];
+// The second pass: y[p] = sum_k U[tripleOf[p][k]] q_k, four pairs per sweep (four running sums).
+QV_HOT void gatheredProductLanes(const double* U, const uint32_t* tripleOf, int r, size_t pairs, const double* q,
+                                 double* y) {
+  constexpr size_t G = 4;
+  size_t p = 0;
+  for (; p + G <= pairs; p += G) {
+    double sum[G][L];
+    for (size_t g = 0; g < G; ++g) {
+      const double* u = U + static_cast<size_t>(tripleOf[blockedAt(r, p + g, 0)]) * L;
 #pragma omp simd
-      for (int l = 0; l < L; ++l) y[s * L + l] += c0 * q0[l] + c1 * q1[l] + c2 * q2[l] + c3 * q3[l];
+      for (int l = 0; l < L; ++l) sum[g][l] = u[l] * q[l];
     }
+    for (int k = 1; k < r; ++k) {
+      const double* qk = q + k * L;
+      for (size_t g = 0; g < G; ++g) {
+        const double* u = U + static_cast<size_t>(tripleOf[blockedAt(r, p + g, k)]) * L;
+#pragma omp simd
+        for (int l = 0; l < L; ++l) sum[g][l] += u[l] * qk[l];
+      }
+    }
+    for (size_t g = 0; g < G; ++g)
+#pragma omp simd
+      for (int l = 0; l < L; ++l) y[(p + g) * L + l] = sum[g][l];
   }
-  for (; k < r; ++k) {
-    const double* t = T + k * n;
-    const double* qk = q + k * L;
-    for (size_t s = 0; s < n; ++s) {
-      const double c = t[s];
+  for (; p < pairs; ++p) {
+    double sum[L] = {};
+    for (int k = 0; k < r; ++k) {
+      const double* u = U + static_cast<size_t>(tripleOf[blockedAt(r, p, k)]) * L;
 #pragma omp simd
-      for (int l = 0; l < L; ++l) y[s * L + l] += c * qk[l];
+      for (int l = 0; l < L; ++l) sum[l] += u[l] * q[k * L + l];
     }
+    for (int l = 0; l < L; ++l) y[p * L + l] = sum[l];
   }
 }
 
 } // namespace
 
 size_t ReducedPolynomial::laneScratchSize(int r) {
-  return (monomialCount2(r) * 3 + 2 * static_cast<size_t>(r) + 1) * L;
+  return (((monomialCount3(r) + 7) & ~size_t(7)) + ((monomialCount2(r) + 7) & ~size_t(7)) + monomialCount2(r) +
+          3 * static_cast<size_t>(r) + 1) *
+         L;
 }
 
 QV_HOT void ReducedPolynomial::evaluateLanes(const double* const* q, int count, double* energy, double* const* force,
                                              double* stiffness, double* scratch) const {
   const int r = r_;
   const size_t P = pairs_;
-  double* x = scratch;   // [pair][lane]: w_kl q_k q_l
-  double* y3 = x + P * L;
-  double* y4 = y3 + P * L;
+  double* u = scratch;  // [triple][lane]: U_ijk (reduced_polynomial.h)
+  double* y3 = u + ((triples_ + 7) & ~size_t(7)) * L;
+  double* y4 = y3 + ((P + 7) & ~size_t(7)) * L;
   double* ql = y4 + P * L;  // [k][lane]: q, zero in unused lanes
   double* Rq = ql + static_cast<size_t>(r) * L;
   double* e = Rq + static_cast<size_t>(r) * L;
+  double* block64 = e + L;  // r kBlock doubles
   for (int k = 0; k < r; ++k)
     for (int l = 0; l < L; ++l) ql[k * L + l] = l < count ? q[l][k] : 0.0;
-  for (int k = 0, s = 0; k < r; ++k)
-    for (int m = k; m < r; ++m, ++s)
-#pragma omp simd
-      for (int l = 0; l < L; ++l) x[s * L + l] = (k == m ? 0.5 : 1.0) * ql[k * L + l] * ql[m * L + l];
-  if (q32_)
-    packedSymmetricProductLanes(q32_, rowStart_, rowOffset_, P, x, y4);
+  if (d32_)
+    blockedProductLanes(d32_, r, triples_, ql, u, block64);
   else
-    packedSymmetricProductLanes(q64_, rowStart_, rowOffset_, P, x, y4);
-  sumOfRowsLanes(t_, r, P, ql, y3);
+    blockedProductLanes(d64_, r, triples_, ql, u, block64);
+  gatheredProductLanes(u, tripleOf_, r, P, ql, y4);
+  blockedProductLanes(t_, r, P, ql, y3, block64);
   std::memset(Rq, 0, sizeof(double) * r * L);
   std::memset(e, 0, sizeof(double) * L);
   // K, the force and the energy as evaluate() assembles them, pair by pair, SIMD across the states.
