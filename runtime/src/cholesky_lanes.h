@@ -22,4 +22,13 @@ inline size_t packedUpperIndex(int n, int i, int j) {
 // the others are not affected by it.
 void choleskyFactorLanes(double* A, int n, bool* ok);
 
+// Lane `lane` of choleskyFactorLanes()'s factors, as choleskySubstitute() (dense_solve.h) reads
+// it; none while A is null.
+struct LaneFactor {
+  static constexpr int kStride = kCholeskyLanes;
+  const double* A = nullptr;
+  int n = 0, lane = 0;
+  const double* row(int i) const { return A + (packedUpperIndex(n, i, i) - static_cast<size_t>(i)) * kStride + lane; }
+};
+
 } // namespace quiver::rt

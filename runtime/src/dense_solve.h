@@ -28,18 +28,30 @@ inline bool choleskyFactor(double* A, int n) {
   return true;
 }
 
-// Solves U^T U x = b with the factor U of choleskyFactor(); b is overwritten by x.
-inline void choleskySubstitute(const double* U, double* b, int n) {
+// A row-major factor as choleskySubstitute() reads it: entry (i, k), k >= i, at row(i)[k * kStride].
+struct DenseFactor {
+  static constexpr int kStride = 1;
+  const double* U;
+  int n;
+  const double* row(int i) const { return U + i * n; }
+};
+
+// Solves U^T U x = b with the factor U of choleskyFactor() (or of choleskyFactorLanes(), read in
+// place: LaneFactor, cholesky_lanes.h; the same operations in the same order); b is overwritten
+// by x.
+template <class Factor>
+inline void choleskySubstitute(const Factor& U, double* b, int n) {
+  constexpr int S = Factor::kStride;
   for (int i = 0; i < n; ++i) {  // U^T y = b
-    const double* rowI = U + i * n;
-    b[i] /= rowI[i];
-    for (int k = i + 1; k < n; ++k) b[k] -= rowI[k] * b[i];
+    const double* rowI = U.row(i);
+    b[i] /= rowI[i * S];
+    for (int k = i + 1; k < n; ++k) b[k] -= rowI[k * S] * b[i];
   }
   for (int i = n - 1; i >= 0; --i) {  // U x = y
-    const double* rowI = U + i * n;
+    const double* rowI = U.row(i);
     double s = b[i];
-    for (int k = i + 1; k < n; ++k) s -= rowI[k] * b[k];
-    b[i] = s / rowI[i];
+    for (int k = i + 1; k < n; ++k) s -= rowI[k * S] * b[k];
+    b[i] = s / rowI[i * S];
   }
 }
 
@@ -48,7 +60,7 @@ inline void choleskySubstitute(const double* U, double* b, int n) {
 // positive definite.
 inline bool choleskySolve(double* A, double* b, int n) {
   if (!choleskyFactor(A, n)) return false;
-  choleskySubstitute(A, b, n);
+  choleskySubstitute(DenseFactor{A, n}, b, n);
   return true;
 }
 

@@ -18,17 +18,17 @@ void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales&
                                  (i == j ? scales.identity : 0.0);
 }
 
-bool takePresetFactor(qv_instance& s, const SystemScales& scales) {
-  const bool factored = s.work.presetFactored && scales == s.work.presetScales;
-  s.work.presetFactored = false;
-  s.work.presetFactorsTaken += factored;
-  return factored;
+LaneFactor takePresetFactor(qv_instance& s, const SystemScales& scales) {
+  const LaneFactor factor = scales == s.work.presetScales ? s.work.presetFactor : LaneFactor{};
+  s.work.presetFactor = LaneFactor{};
+  s.work.presetFactorsTaken += factor.A != nullptr;
+  return factor;
 }
 
 void elasticityAt(qv_instance& s, const double* q, double* energy, double* force) {
   const bool preset = s.work.presetValid && std::memcmp(q, s.work.presetAt, sizeof(double) * s.r) == 0;
   s.work.presetValid = false;  // only ever the next evaluation: the one after is elsewhere
-  s.work.presetFactored = s.work.presetFactored && preset;
+  if (!preset) s.work.presetFactor = LaneFactor{};
   if (preset) {
     std::memcpy(force, s.work.presetForce, sizeof(double) * s.r);
     if (energy) *energy = s.work.presetEnergy;
@@ -44,8 +44,8 @@ const double* evaluateForces(qv_instance& s, const double* q) {
 
 QV_HOT qv_step_status solveNewton(qv_instance& s, const double* stateJacobian, double c1, double c2) {
   const SystemScales scales = newtonSystem(s, c1, c2);
-  if (takePresetFactor(s, scales)) {
-    choleskySubstitute(s.work.system, s.work.correction, s.r);
+  if (const LaneFactor factor = takePresetFactor(s, scales); factor.A) {
+    choleskySubstitute(factor, s.work.correction, s.r);
     return QV_STEP_OK;
   }
   fillSystem(s, stateJacobian, scales, true);

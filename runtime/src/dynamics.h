@@ -34,9 +34,9 @@ inline SystemScales newtonSystem(const qv_instance& s, double c1, double c2) {
 // the whole.
 void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales& scales, bool upper);
 
-// Whether s.work.system holds a group's Cholesky factor (step_many.h) of the matrix with these
-// scales at the point just evaluated; the factor is taken either way.
-bool takePresetFactor(qv_instance& s, const SystemScales& scales);
+// The group's Cholesky factor (step_many.h) of the matrix with these scales at the point just
+// evaluated, or none (A null); taken either way.
+LaneFactor takePresetFactor(qv_instance& s, const SystemScales& scales);
 
 // Solves the Newton system for the right-hand side in s.work.correction (the correction replaces
 // it): Cholesky, or pivoting LU (QV_STEP_INDEFINITE) when large compression has made the matrix

@@ -211,7 +211,8 @@ void qv_instance::moveFrame() {
 }
 
 qv_step_status qv_instance::endStep(qv_step_status status) {
-  work.presetValid = work.presetFactored = false;
+  work.presetValid = false;
+  work.presetFactor = quiver::rt::LaneFactor{};
   loads.endStep();
   if (status == QV_STEP_RESET || !healthy()) {
     rest();

@@ -2,6 +2,7 @@
 // qv_instance: one simulated object, in one block: its settings, its state (q, v, a), its loads
 // and the buffers of the step. Integrators (integrators/) advance it; dynamics.h evaluates it.
 #include "block_carver.h"
+#include "cholesky_lanes.h"
 #include "contact_list.h"
 #include "loads.h"
 #include "model.h"
@@ -51,9 +52,10 @@ struct StepBuffers {
   double presetEnergy = 0;
   bool presetValid = false;
   // The group also factorises the matrix the step will solve with at that point (the system with
-  // presetScales), into `system`; the solver takes it right after the preset (takePresetFactor(),
-  // dynamics.h) instead of filling and factorising its own.
-  bool presetFactored = false;
+  // presetScales), in its own scratch; the solver takes it right after the preset
+  // (takePresetFactor(), dynamics.h), before the group evaluates again, instead of filling and
+  // factorising its own.
+  LaneFactor presetFactor;
   SystemScales presetScales;
   unsigned long long presetFactorsTaken = 0;  // solves that took a group's factor (tests, diagnostics)
 };

@@ -36,9 +36,9 @@ QV_HOT void unpackUpper(const double* lanes, int r, int count, double* const* ou
 }
 
 // Factorises together the members' matrices with `scales` (SystemScales, instance.h) at the
-// point just evaluated, `A` holding the group's K (as evaluateLanes() leaves it), and hands each
-// factor to its member's solver in `system` (presetFactored). Lanes not factorised
-// (factorisedInGroup()) factorise the identity.
+// point just evaluated, `A` holding the group's K (as evaluateLanes() leaves it), in place, and
+// hands each member its lane of A (presetFactor). Lanes not factorised (factorisedInGroup())
+// factorise the identity.
 QV_HOT void factoriseGroup(qv_instance* const* group, int count, const SystemScales* scales, double* A) {
   const int r = group[0]->r;
   const double* K0 = group[0]->model->restStiffness;
@@ -69,13 +69,10 @@ QV_HOT void factoriseGroup(qv_instance* const* group, int count, const SystemSca
     }
   bool ok[kLanes];
   choleskyFactorLanes(A, r, ok);
-  double* system[kLanes] = {};
-  for (int l = 0; l < count; ++l) system[l] = group[l]->work.system;
-  unpackUpper(A, r, count, system);
   for (int l = 0; l < count; ++l) {
     qv_instance& s = *group[l];
     // Not positive definite: the solver's own factorisation decides (pivoting LU, or a shift).
-    s.work.presetFactored = ok[l] && factorisedInGroup(s);
+    s.work.presetFactor = ok[l] && factorisedInGroup(s) ? LaneFactor{A, r, l} : LaneFactor{};
     s.work.presetScales = lane[l];
   }
 }

@@ -56,8 +56,8 @@ public:
   bool direction(const double* jacobian, bool& failed) {
     SystemScales scales = minimizerSystem(s_, p_);
     for (int i = 0; i < r_; ++i) s_.work.correction[i] = -s_.work.gradient[i];
-    if (takePresetFactor(s_, scales)) {
-      choleskySubstitute(s_.work.system, s_.work.correction, r_);
+    if (const LaneFactor factor = takePresetFactor(s_, scales); factor.A) {
+      choleskySubstitute(factor, s_.work.correction, r_);
       return false;
     }
     const double diagonal = scales.identity;
