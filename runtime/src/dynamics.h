@@ -16,12 +16,9 @@ void elasticityAt(qv_instance& s, const double* q, double* energy, double* force
 // Fills s.work.force = R(q) + S(q) and s.work.stiffness = K(q); returns J.
 const double* evaluateForces(qv_instance& s, const double* q);
 
-// (C v)_i with the elastic stiffness last evaluated.
-inline double dampingForce(const qv_instance& s, int i, const double* v) {
-  double d = s.config.rayleigh_alpha * v[i];
-  for (int j = 0; j < s.r; ++j) d += s.config.rayleigh_beta * s.work.stiffness[i * s.r + j] * v[j];
-  return d;
-}
+// C v = alpha v + beta K v into `out` (r values), with the elastic stiffness last evaluated: K is
+// symmetric, so the product runs along its rows as axpys (SIMD across i), each sum over j in order.
+void dampingForces(const qv_instance& s, const double* v, double* out);
 
 // The fixed Newton step's (I + c1 C + c2 (K + J)), C = alpha I + beta K(q). Fused explicitly: the
 // group and the solver compute it in code built for different instruction sets, and a group's

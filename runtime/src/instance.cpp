@@ -107,6 +107,7 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
   work.stiffness = c.take<double>(rr);
   work.system = c.take<double>(rr);
   work.correction = c.take<double>(r);
+  work.damping = c.take<double>(r);
   work.predictor = c.take<double>(r);
   work.predictorVelocity = c.take<double>(r);
   work.gradient = c.take<double>(r);
@@ -240,7 +241,8 @@ void qv_instance::setState(const double* newQ, const double* newV, const double*
     // The acceleration the equations of motion give at the new state (persistent loads only), so
     // that the next implicit step starts consistent rather than injecting energy.
     quiver::rt::evaluateForces(*this, q);
-    for (int i = 0; i < r; ++i) a[i] = loads.gravityForce[i] - work.force[i] - quiver::rt::dampingForce(*this, i, v);
+    quiver::rt::dampingForces(*this, v, work.damping);
+    for (int i = 0; i < r; ++i) a[i] = loads.gravityForce[i] - work.force[i] - work.damping[i];
   }
   if (newQ) elasticEnergyAtState = quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
   energySlack = 0;

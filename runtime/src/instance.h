@@ -35,6 +35,7 @@ struct StepBuffers {
                                   // evaluation for a minimising step, its upper triangle only
   double* system = nullptr;       // the Newton matrix, factorised in place
   double* correction = nullptr;   // the Newton right-hand side in, the correction out
+  double* damping = nullptr;      // C v (dampingForces(), dynamics.h)
   double* predictor = nullptr;    // the minimising solver's qt and v0 (incremental_potential.h)
   double* predictorVelocity = nullptr;
   double* gradient = nullptr;     // its gradient at the current iterate

@@ -40,9 +40,9 @@ qv_step_status stepBackwardEuler(qv_instance& s) {
   for (int it = 0; it < s.config.newton_iterations; ++it, ++s.lastStep.newton_iterations) {
     for (int i = 0; i < r; ++i) s.end.q[i] = q[i] + h * s.end.v[i];
     const double* J = evaluateForces(s, s.end.q);
+    dampingForces(s, s.end.v, s.work.damping);
     for (int i = 0; i < r; ++i)
-      s.work.correction[i] =
-          -((s.end.v[i] - v[i]) + h * (dampingForce(s, i, s.end.v) + s.work.force[i] - s.loads.external(i)));
+      s.work.correction[i] = -((s.end.v[i] - v[i]) + h * (s.work.damping[i] + s.work.force[i] - s.loads.external(i)));
     const qv_step_status solved = solveNewton(s, J, h, h * h);
     if (solved == QV_STEP_RESET) return solved;
     if (solved == QV_STEP_INDEFINITE) status = solved;

@@ -12,7 +12,8 @@ qv_step_status stepCentralDifferences(qv_instance& s) {
   for (int i = 0; i < r; ++i) q[i] += h * v[i] + 0.5 * h * h * a[i];
   evaluateForces(s, q);
   for (int i = 0; i < r; ++i) s.end.v[i] = v[i] + h * a[i];
-  for (int i = 0; i < r; ++i) s.end.a[i] = s.loads.external(i) - s.work.force[i] - dampingForce(s, i, s.end.v);
+  dampingForces(s, s.end.v, s.work.damping);
+  for (int i = 0; i < r; ++i) s.end.a[i] = s.loads.external(i) - s.work.force[i] - s.work.damping[i];
   for (int i = 0; i < r; ++i) {
     v[i] += 0.5 * h * (a[i] + s.end.a[i]);
     a[i] = s.end.a[i];

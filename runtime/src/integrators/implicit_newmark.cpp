@@ -46,8 +46,9 @@ qv_step_status stepImplicitNewmark(qv_instance& s) {
       s.end.v[i] = v[i] + h * ((1 - gamma) * a[i] + gamma * s.end.a[i]);
     }
     const double* J = evaluateForces(s, s.end.q);
+    dampingForces(s, s.end.v, s.work.damping);
     for (int i = 0; i < r; ++i)
-      s.work.correction[i] = -(s.end.a[i] + dampingForce(s, i, s.end.v) + s.work.force[i] - s.loads.external(i));
+      s.work.correction[i] = -(s.end.a[i] + s.work.damping[i] + s.work.force[i] - s.loads.external(i));
     double c1, c2;
     newmarkNewtonScales(s, c1, c2);
     const qv_step_status solved = solveNewton(s, J, c1, c2);
