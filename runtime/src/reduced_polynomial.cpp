@@ -268,7 +268,7 @@ void ReducedPolynomial::evaluate(const double* q, double* energy, double* force,
     for (int b = a; b < r; ++b, ++p) {
       const double k2 = k2_[p], s3 = y3[p], s4 = y4[p];
       if (stiffness) stiffness[a * r + b] = stiffness[b * r + a] = k2 + s3 + s4;
-      const double f = k2 + s3 / 2 + s4 / 3, h = k2 / 2 + s3 / 6 + s4 / 12;
+      const double f = k2 + 0.5 * s3 + kThird * s4, h = 0.5 * k2 + kSixth * s3 + kTwelfth * s4;
       Rq[a] += f * q[b];
       if (b != a) Rq[b] += f * q[a];
       e += (a == b ? 1.0 : 2.0) * h * q[a] * q[b];
