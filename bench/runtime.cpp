@@ -217,7 +217,7 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark(("Step/minimize" + r).c_str(), Step, path, QV_SOLVER_MINIMIZE, 64)->Unit(benchmark::kMicrosecond);
     for (bool single : {false, true})
       benchmark::RegisterBenchmark(("Stream/" + std::string(single ? "f32" : "f64") + r).c_str(), Stream,
-                                   quiver::rt::ReducedPolynomial::storageBytes(probe.info.r, single))
+                                   quiver::rt::ReducedPolynomial::evaluationBytes(probe.info.r, single))
           ->Unit(benchmark::kMicrosecond);
     if (probe.info.r == 20 || probe.info.r == 30)
       for (qv_solver solver : {QV_SOLVER_NEWTON, QV_SOLVER_MINIMIZE})

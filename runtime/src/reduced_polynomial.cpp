@@ -125,7 +125,7 @@ QV_HOT void blockedProduct(const double* B, int r, size_t rows, const double* q,
 
 } // namespace
 
-ReducedPolynomial::Arrays ReducedPolynomial::carve(BlockCarver& c, bool single) const {
+ReducedPolynomial::Arrays ReducedPolynomial::carve(BlockCarver& c, bool single, bool groups) const {
   Arrays a{};
   a.k2 = c.take<double>(pairs_);
   a.t = c.take<double>(static_cast<size_t>(r_) * blockedRows(pairs_));
@@ -135,6 +135,7 @@ ReducedPolynomial::Arrays ReducedPolynomial::carve(BlockCarver& c, bool single) 
     a.q32 = c.take<float>(packedCount(pairs_));
   else
     a.q64 = c.take<double>(packedCount(pairs_));
+  if (!groups) return a;
   const size_t d = static_cast<size_t>(r_) * blockedRows(triples_);
   if (single)
     a.d32 = c.take<float>(d);
@@ -144,15 +145,19 @@ ReducedPolynomial::Arrays ReducedPolynomial::carve(BlockCarver& c, bool single) 
   return a;
 }
 
-size_t ReducedPolynomial::storageBytes(int r, bool single) {
+size_t ReducedPolynomial::measure(int r, bool single, bool groups) {
   ReducedPolynomial measured;
   measured.r_ = r;
   measured.pairs_ = monomialCount2(r);
   measured.triples_ = monomialCount3(r);
   BlockCarver c(nullptr);
-  measured.carve(c, single);
+  measured.carve(c, single, groups);
   return c.size();
 }
+
+size_t ReducedPolynomial::storageBytes(int r, bool single) { return measure(r, single, true); }
+
+size_t ReducedPolynomial::evaluationBytes(int r, bool single) { return measure(r, single, false); }
 
 size_t ReducedPolynomial::scratchSize(int r) {
   return monomialCount2(r) * 2 + blockedRows(monomialCount2(r)) + static_cast<size_t>(r);
@@ -164,7 +169,7 @@ void ReducedPolynomial::build(int r, const double* c, bool single, void* storage
   triples_ = monomialCount3(r);
   const size_t P = pairs_;
   BlockCarver carver(static_cast<char*>(storage));
-  const Arrays arrays = carve(carver, single);
+  const Arrays arrays = carve(carver, single, true);
   std::memset(storage, 0, carver.size());
   double* k2 = arrays.k2;
   double* t = arrays.t;

@@ -29,6 +29,8 @@ public:
   // and doubles of scratch for evaluate().
   static size_t storageBytes(int r, bool single);
   static size_t scratchSize(int r);
+  // The bytes of that storage one state's evaluate() reads (all but the groups' rows of D).
+  static size_t evaluationBytes(int r, bool single);
 
   // Builds the layout in `storage` (storageBytes(r, single) bytes, 64-byte aligned, owned by the
   // caller) from the energy monomial coefficients of formats/model/qvr.h.
@@ -69,8 +71,10 @@ private:
     float* d32;
     uint32_t* tripleOf;
   };
-  // Takes the arrays for r_ from `c` (null pointers while it measures).
-  Arrays carve(BlockCarver& c, bool single) const;
+  // Takes the arrays for r_ from `c` (null pointers while it measures): one state's, then, with
+  // `groups`, the groups' own.
+  Arrays carve(BlockCarver& c, bool single, bool groups) const;
+  static size_t measure(int r, bool single, bool groups);
 
   // Euler's weights (the header's formulas) as products: three divisions per pair had cost about
   // a tenth of an evaluation.
