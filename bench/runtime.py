@@ -93,7 +93,7 @@ def main():
               f"{reference / newton['real_time']:.1f} | {minimize['real_time']:.2f} | {minimize['newton_per_step']:.2f} | {gflops:.1f} | {gflops / peak_gflops:.0%} |")
     print("\nCoefficient precision and the memory floor (force + stiffness; *stream* reads the same bytes as "
           "doubles, same run):\n")
-    print("| r | coefficients f64 (MB) | evaluation f64 (us) | stream f64 (us) | f64 / stream | evaluation f32 (us) "
+    print("| r | one state reads, f64 (MB) | evaluation f64 (us) | stream f64 (us) | f64 / stream | evaluation f32 (us) "
           "| stream f32 (us) | f32 / stream | f32 speed-up | Newmark step f64 (us) | Newmark step f32 (us) |")
     print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for r in RANKS:

@@ -111,7 +111,7 @@ qv_result qv_solver_from_name(const char* name, qv_solver* solver) { return from
 // ---- Models ----
 
 void qv_model_config_init(qv_model_config* config) {
-  if (config) config->coefficient_precision = 64;
+  if (config) *config = qv_model_config{64, -1};
 }
 
 void qv_allocator_init(qv_allocator* allocator) {
@@ -125,7 +125,8 @@ qv_result qv_model_load_memory(const void* data, size_t size, const qv_model_con
   qv_model_config defaults;
   qv_model_config_init(&defaults);
   const qv_model_config& settings = config ? *config : defaults;
-  if ((!data && size) || (settings.coefficient_precision != 32 && settings.coefficient_precision != 64))
+  if ((!data && size) || (settings.coefficient_precision != 32 && settings.coefficient_precision != 64) ||
+      settings.group_layout < -1 || settings.group_layout > 1)
     return QV_ERROR_INVALID_ARGUMENT;
   const qv_allocator use = allocatorOr(allocator);
   // The reader wants an 8-byte aligned image; a caller's buffer may not be.

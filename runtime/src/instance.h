@@ -54,8 +54,9 @@ struct StepBuffers {
   bool presetValid = false;
   // The group also factorises the matrix the step will solve with at that point (the system with
   // presetScales), in its own scratch; the solver takes it right after the preset
-  // (takePresetFactor(), dynamics.h), before the group evaluates again, instead of filling and
-  // factorising its own.
+  // (takePresetFactor(), dynamics.h) instead of filling and factorising its own. Untaken (the
+  // step ended, or went elsewhere), it is dropped when the step evaluates elsewhere or ends, and
+  // replaced at the group's next evaluation, before the scratch is overwritten.
   LaneFactor presetFactor;
   SystemScales presetScales;
   unsigned long long presetFactorsTaken = 0;  // solves that took a group's factor (tests, diagnostics)

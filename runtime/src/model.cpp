@@ -49,12 +49,12 @@ double restStiffnessAndLargestEigenvalue(const qv_model& m, double* stiffness, d
 
 // Lays the model out in `block` (null: only measures it) and, when placing, copies the view in
 // and computes K(0) and the stable step. Returns the block's size.
-size_t layOut(const ModelView& view, bool single, const qv_allocator& allocator, char* block) {
+size_t layOut(const ModelView& view, bool single, bool groups, const qv_allocator& allocator, char* block) {
   const ModelInfo& in = view.info;
   const size_t r = in.r, n = in.vertexCount;
   BlockCarver c(block);
   qv_model* m = c.take<qv_model>(1);
-  char* polynomial = c.take<char>(ReducedPolynomial::storageBytes(in.r, single));
+  char* polynomial = c.take<char>(ReducedPolynomial::storageBytes(in.r, single, groups));
   float* basis32 = view.basis32 ? c.take<float>(3 * n * r) : nullptr;
   double* basis64 = view.basis32 ? nullptr : c.take<double>(3 * n * r);
   double* rest = c.take<double>(3 * n);
@@ -82,7 +82,7 @@ size_t layOut(const ModelView& view, bool single, const qv_allocator& allocator,
                           in.totalMass, in.rayleighAlpha, in.rayleighBeta, in.timeStep,
                           {in.bboxMin[0], in.bboxMin[1], in.bboxMin[2]}, {in.bboxMax[0], in.bboxMax[1], in.bboxMax[2]},
                           static_cast<int>(view.renderVertexCount), static_cast<int>(view.renderTriangleCount)};
-  m->polynomial.build(in.r, view.energy, single, polynomial);
+  m->polynomial.build(in.r, view.energy, single, groups, polynomial);
   const auto copy = [](auto* target, const auto* source, size_t count) {
     if (count) std::memcpy(target, source, count * sizeof(*target));
     return target;
@@ -123,10 +123,12 @@ qv_result loadModel(const void* data, size_t size, const qv_model_config& config
     return QV_ERROR_FORMAT;
   }
   const bool single = config.coefficient_precision == 32;
-  const size_t bytes = layOut(view, single, allocator, nullptr);
+  // Past r = 64 the groups' rows would take more than 23 MB (quiver.h).
+  const bool groups = config.group_layout == 1 || (config.group_layout == -1 && view.info.r <= 64);
+  const size_t bytes = layOut(view, single, groups, allocator, nullptr);
   char* block = static_cast<char*>(allocator.allocate(bytes, 64, allocator.user));
   if (!block) return QV_ERROR_OUT_OF_MEMORY;
-  layOut(view, single, allocator, block);
+  layOut(view, single, groups, allocator, block);
   qv_model* model = reinterpret_cast<qv_model*>(block);
   if (model->contactCount < 0) {
     destroyModel(model);

@@ -32,9 +32,8 @@ double repeatFactor(const int (&idx)[N]) {
 
 size_t align8(size_t n) { return n & ~size_t(7); }
 
-// Rows padded to whole blocks (ReducedPolynomial::kBlock = 8), and where entry (i, k) of r columns sits.
+// Rows padded to whole blocks (ReducedPolynomial::kBlock = 8).
 size_t blockedRows(size_t rows) { return (rows + 7) & ~size_t(7); }
-size_t blockedAt(int r, size_t i, int k) { return align8(i) * r + static_cast<size_t>(k) * 8 + (i & 7); }
 
 size_t packedCount(size_t pairs) {
   size_t total = 0;
@@ -155,7 +154,7 @@ size_t ReducedPolynomial::measure(int r, bool single, bool groups) {
   return c.size();
 }
 
-size_t ReducedPolynomial::storageBytes(int r, bool single) { return measure(r, single, true); }
+size_t ReducedPolynomial::storageBytes(int r, bool single, bool groups) { return measure(r, single, groups); }
 
 size_t ReducedPolynomial::evaluationBytes(int r, bool single) { return measure(r, single, false); }
 
@@ -163,13 +162,13 @@ size_t ReducedPolynomial::scratchSize(int r) {
   return monomialCount2(r) * 2 + blockedRows(monomialCount2(r)) + static_cast<size_t>(r);
 }
 
-void ReducedPolynomial::build(int r, const double* c, bool single, void* storage) {
+void ReducedPolynomial::build(int r, const double* c, bool single, bool groups, void* storage) {
   r_ = r;
   pairs_ = monomialCount2(r);
   triples_ = monomialCount3(r);
   const size_t P = pairs_;
   BlockCarver carver(static_cast<char*>(storage));
-  const Arrays arrays = carve(carver, single, true);
+  const Arrays arrays = carve(carver, single, groups);
   std::memset(storage, 0, carver.size());
   double* k2 = arrays.k2;
   double* t = arrays.t;
@@ -223,8 +222,8 @@ void ReducedPolynomial::build(int r, const double* c, bool single, void* storage
                 if (s != x && s != y) rest[n++] = idx[s];
               setQ(pairIndex(r, idx[x], idx[y]), pairIndex(r, rest[0], rest[1]), value);
             }
-          // Row (the triple left) and column (the index taken out) of the two-pass rows.
-          for (int x = 0; x < 4; ++x) {
+          // Row (the triple left) and column (the index taken out) of the groups' two-pass rows.
+          for (int x = 0; groups && x < 4; ++x) {
             int rest[3], n = 0;
             for (int s = 0; s < 4; ++s)
               if (s != x) rest[n++] = idx[s];
@@ -235,7 +234,7 @@ void ReducedPolynomial::build(int r, const double* c, bool single, void* storage
               arrays.d64[at] = value / 2;
           }
         }
-  for (int a = 0, p = 0; a < r; ++a)
+  for (int a = 0, p = 0; groups && a < r; ++a)
     for (int b = a; b < r; ++b, ++p)
       for (int k = 0; k < r; ++k) {
         const int lo = k < a ? k : a, mid = k < a ? a : (k < b ? k : b), hi = k < b ? b : k;

@@ -12,10 +12,11 @@
 // from the same parts, with no second pass:
 //   R(q) = (K_2 + K_3(q)/2 + K_4(q)/3) q,   E(q) = q^T (K_2/2 + K_3(q)/6 + K_4(q)/12) q.
 //
-// Groups of states (evaluateLanes) contract the quartic part in two passes instead, which takes a
-// third fewer multiply-adds where the arithmetic, not the memory, bounds the work: first
-// U_ijk = sum_l D_ijkl q_l / 2 for the triples i <= j <= k (D the fourth derivative of E_4), then
-// K_4,ab = sum_k U_sort(a,b,k) q_k. At r = 30 the D rows take 1.2 MB more in float64.
+// Groups of states (evaluateLanes), where the arithmetic, not the memory, bounds the work, contract
+// the quartic part in two passes instead, with about a quarter fewer multiply-adds (177k instead of
+// 230k at r = 30, the cubic part included): first U_ijk = sum_l D_ijkl q_l / 2 for the triples
+// i <= j <= k (D the fourth derivative of E_4), then K_4,ab = sum_k U_sort(a,b,k) q_k. The rows
+// of D are a layout of their own (1.2 MB more at r = 30 in float64), built only when asked.
 #include <cstddef>
 #include <cstdint>
 
@@ -25,41 +26,48 @@ namespace quiver::rt {
 
 class ReducedPolynomial {
 public:
-  // Bytes of storage for a basis of size r with coefficients in float32 (single) or float64,
-  // and doubles of scratch for evaluate().
-  static size_t storageBytes(int r, bool single);
+  // Bytes of storage for a basis of size r with coefficients in float32 (single) or float64, with
+  // or without the groups' layout (evaluateLanes), and doubles of scratch for evaluate().
+  static size_t storageBytes(int r, bool single, bool groups);
   static size_t scratchSize(int r);
-  // The bytes of that storage one state's evaluate() reads (all but the groups' rows of D).
+  // The bytes of that storage one state's evaluate() reads (none of the groups' own arrays).
   static size_t evaluationBytes(int r, bool single);
 
-  // Builds the layout in `storage` (storageBytes(r, single) bytes, 64-byte aligned, owned by the
-  // caller) from the energy monomial coefficients of formats/model/qvr.h.
-  void build(int r, const double* energyCoefficients, bool single, void* storage);
+  // Builds the layout in `storage` (storageBytes(r, single, groups) bytes, 64-byte aligned, owned
+  // by the caller) from the energy monomial coefficients of formats/model/qvr.h.
+  void build(int r, const double* energyCoefficients, bool single, bool groups, void* storage);
 
   // Any of energy, force (r) and stiffness (r x r, row-major) may be null. `scratch`: scratchSize(r) doubles.
   void evaluate(const double* q, double* energy, double* force, double* stiffness, double* scratch) const;
 
-  // The same for up to kLanes states at once (reduced_polynomial_lanes.cpp): each coefficient is
-  // read once for all of them and multiplies a vector of kLanes values, one per state: the work is
-  // bound by arithmetic, not by streaming the coefficients from L2 as one state's is. Entry i of q,
-  // energy and force belongs to state i < count (none may be null); `stiffness` receives the K(q)
-  // of all kLanes lanes (unused lanes: at q = 0), upper triangles packed row by row and interleaved
-  // by lane: K_ab of state l at stiffness[p * kLanes + l], p the pair (a <= b) in row order
-  // (r(r+1)/2 x kLanes doubles). The sums run in another order than evaluate()'s, so results
-  // agree with it to rounding, not bit for bit. `scratch`: laneScratchSize(r) doubles, 64-byte
-  // aligned.
+  // Rows of r coefficients, blocked eight rows at a time ([block][k][8]) so that one row block
+  // times q is one vector of eight sums per k.
+  static constexpr int kBlock = 8;
+  // Where entry (i, k) of a blocked matrix of r columns sits.
+  static size_t blockedAt(int r, size_t i, int k) {
+    return (i / kBlock * r + static_cast<size_t>(k)) * kBlock + i % kBlock;
+  }
+
+  // The same for up to kLanes states at once (reduced_polynomial_lanes.cpp), with the groups'
+  // layout only (groups()): each coefficient is read once for all of them and multiplies a vector
+  // of kLanes values, one per state: the work is bound by arithmetic, not by streaming the
+  // coefficients from L2 as one state's is. Entry i of q, energy and force belongs to state
+  // i < count (none may be null); `stiffness` receives the K(q) of all kLanes lanes (unused lanes:
+  // at q = 0), upper triangles packed row by row and interleaved by lane: K_ab of state l at
+  // stiffness[p * kLanes + l], p the pair (a <= b) in row order (r(r+1)/2 x kLanes doubles). The
+  // sums run in another order than evaluate()'s, so results agree with it to rounding, not bit for
+  // bit. `scratch`: laneScratchSize(r) doubles, 64-byte aligned.
   static constexpr int kLanes = 8;
+  static_assert(kBlock == kLanes, "laneScratchSize() counts a converted float32 block as r kLanes doubles");
   static size_t laneScratchSize(int r);
   void evaluateLanes(const double* const* q, int count, double* energy, double* const* force, double* stiffness,
                      double* scratch) const;
 
   int r() const { return r_; }
   bool single() const { return q32_ != nullptr; }
+  bool groups() const { return tripleOf_ != nullptr; }
 
 private:
-  // Rows of r coefficients, blocked eight rows at a time ([block][k][8]) so that one row block
-  // times q is one vector of eight sums per k.
-  static constexpr int kBlock = 8;
   struct Arrays {
     double* k2;
     double* t;
@@ -91,7 +99,7 @@ private:
   const float* q32_ = nullptr;   // the same in float32, or null
   const double* d64_ = nullptr;  // D_ijkl / 2, rows (i <= j <= k) blocked over l, float64, or null
   const float* d32_ = nullptr;   // the same in float32, or null
-  const uint32_t* tripleOf_ = nullptr;  // [pair][k]: the triple sort(a, b, k)
+  const uint32_t* tripleOf_ = nullptr;  // the triple sort(a, b, k), blocked over k as t_ is
 };
 
 } // namespace quiver::rt

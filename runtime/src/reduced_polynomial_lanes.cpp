@@ -15,8 +15,6 @@ namespace {
 
 constexpr int L = ReducedPolynomial::kLanes;
 
-// Where entry (i, k) of r columns sits in a blocked layout (ReducedPolynomial::kBlock).
-size_t blockedAt(int r, size_t i, int k) { return (i & ~size_t(7)) * r + static_cast<size_t>(k) * 8 + (i & 7); }
 
 // y[i] = sum_k B_ik q_k for the rows of a blocked matrix (ReducedPolynomial::kBlock): eight rows
 // per sweep, each coefficient broadcast against q_k's lanes into one of eight running sums. y has
@@ -59,14 +57,14 @@ QV_HOT void gatheredProductLanes(const double* U, const uint32_t* tripleOf, int 
   for (; p + G <= pairs; p += G) {
     double sum[G][L];
     for (size_t g = 0; g < G; ++g) {
-      const double* u = U + static_cast<size_t>(tripleOf[blockedAt(r, p + g, 0)]) * L;
+      const double* u = U + static_cast<size_t>(tripleOf[ReducedPolynomial::blockedAt(r, p + g, 0)]) * L;
 #pragma omp simd
       for (int l = 0; l < L; ++l) sum[g][l] = u[l] * q[l];
     }
     for (int k = 1; k < r; ++k) {
       const double* qk = q + k * L;
       for (size_t g = 0; g < G; ++g) {
-        const double* u = U + static_cast<size_t>(tripleOf[blockedAt(r, p + g, k)]) * L;
+        const double* u = U + static_cast<size_t>(tripleOf[ReducedPolynomial::blockedAt(r, p + g, k)]) * L;
 #pragma omp simd
         for (int l = 0; l < L; ++l) sum[g][l] += u[l] * qk[l];
       }
@@ -78,7 +76,7 @@ QV_HOT void gatheredProductLanes(const double* U, const uint32_t* tripleOf, int 
   for (; p < pairs; ++p) {
     double sum[L] = {};
     for (int k = 0; k < r; ++k) {
-      const double* u = U + static_cast<size_t>(tripleOf[blockedAt(r, p, k)]) * L;
+      const double* u = U + static_cast<size_t>(tripleOf[ReducedPolynomial::blockedAt(r, p, k)]) * L;
 #pragma omp simd
       for (int l = 0; l < L; ++l) sum[l] += u[l] * q[k * L + l];
     }

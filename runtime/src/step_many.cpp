@@ -16,9 +16,11 @@ constexpr int kLanes = ReducedPolynomial::kLanes;
 
 size_t pairs(int r) { return static_cast<size_t>(r) * (r + 1) / 2; }
 
-// Whose step begins with a polynomial evaluation at newmarkGuess(): both Newmark solvers do.
+// Whose step begins with a polynomial evaluation at newmarkGuess() (both Newmark solvers' does),
+// on a model laid out for groups (qv_model_config.group_layout).
 bool groupable(const qv_instance& s) {
-  return s.config.integrator == QV_INTEGRATOR_IMPLICIT_NEWMARK && s.config.elasticity == QV_ELASTICITY_STVK;
+  return s.config.integrator == QV_INTEGRATOR_IMPLICIT_NEWMARK && s.config.elasticity == QV_ELASTICITY_STVK &&
+         s.model->polynomial.groups();
 }
 
 // Whether the group factorises the matrices a member's solver will solve with: not in flight, where
@@ -54,6 +56,7 @@ QV_HOT void factoriseGroup(qv_instance* const* group, int count, const SystemSca
     constrained = constrained || (factorised && s.loads.constrained);
     rest = rest || lane[l].restStiffness != 0;
   }
+  for (int l = 0; l < count; ++l) group[l]->work.presetFactor = LaneFactor{};
   if (!any) return;
   // The terms in fillSystem()'s order (dynamics.cpp).
   for (int a = 0, p = 0; a < r; ++a)

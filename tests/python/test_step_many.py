@@ -50,6 +50,20 @@ def test_states_agree_with_stepping_one_by_one(model, tip, solver):
     assert 0 < np.abs(a - b).max() < 1e-9 * largest
 
 
+def test_a_model_without_the_group_layout_steps_its_instances_alone(model_path, tip):
+    plain = quiver.Model(model_path, group_layout=0)
+    batched, single = crowd(plain, 9), crowd(plain, 9)
+    for step in range(30):
+        load(batched, step, tip)
+        load(single, step, tip)
+        quiver.step_many(batched)
+        for s in single:
+            s.step()
+    np.testing.assert_array_equal(states(batched), states(single))
+    with pytest.raises(ValueError, match="group_layout must be -1, 0 or 1"):
+        quiver.Model(model_path, group_layout=2)
+
+
 def test_threads_give_the_same_bits_as_one_job(model, tip):
     count = 19  # groups of 8, 8, 3 whatever the threads
     one, two, three = crowd(model, count), crowd(model, count), crowd(model, count)

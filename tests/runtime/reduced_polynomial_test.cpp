@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "formats/model/qvr.h"
@@ -72,16 +73,19 @@ double largest(const std::vector<double>& x) {
 
 } // namespace
 
+// float32 coefficients: within 1e-6 of the exact values (the coefficients' rounding, summed), and
+// the two layouts within 1e-13 of each other (the same rounded coefficients).
 TEST(ReducedPolynomial, BothLayoutsAgreeWithTheEnergyDifferentiatedTermByTerm) {
   std::mt19937 rng(7);
   std::normal_distribution<double> n(0, 1);
   constexpr int L = ReducedPolynomial::kLanes;
+  for (bool single : {false, true})
   for (int r : {1, 2, 3, 7, 8, 9, 17}) {
     std::vector<double> c(quiver::energyCoefficientCount(r));
     for (double& x : c) x = n(rng);
-    auto storage = aligned(ReducedPolynomial::storageBytes(r, false));
+    auto storage = aligned(ReducedPolynomial::storageBytes(r, single, true));
     ReducedPolynomial poly;
-    poly.build(r, c.data(), false, storage.get());
+    poly.build(r, c.data(), single, true, storage.get());
     std::vector<double> oneScratch(ReducedPolynomial::scratchSize(r));
     auto laneScratch = aligned(ReducedPolynomial::laneScratchSize(r) * sizeof(double));
     std::vector<std::vector<double>> q(L, std::vector<double>(r)), f(L, std::vector<double>(r));
@@ -97,19 +101,21 @@ TEST(ReducedPolynomial, BothLayoutsAgreeWithTheEnergyDifferentiatedTermByTerm) {
       poly.evaluateLanes(at.data(), count, energy, forces.data(), lanes.data(), static_cast<double*>(laneScratch.get()));
       for (int l = 0; l < count; ++l) {
         const Reference exact(r, c, q[l]);
-        const double tolerance = 1e-13 * std::max(1.0, largest(exact.hessian));
+        const double scale = std::max(1.0, largest(exact.hessian)), tolerance = (single ? 1e-6 : 1e-13) * scale;
+        const double agree = 1e-13 * scale;  // one layout against the other
         double e1 = 0;
         std::vector<double> f1(r), K1(r * r);
         poly.evaluate(q[l].data(), &e1, f1.data(), K1.data(), oneScratch.data());
-        EXPECT_NEAR(e1, exact.energy, tolerance) << "r = " << r;
-        EXPECT_NEAR(energy[l], exact.energy, tolerance) << "r = " << r << ", lane " << l;
+        const std::string where = std::string(single ? "float32" : "float64") + ", r = " + std::to_string(r) +
+                                  ", lane " + std::to_string(l);
+        EXPECT_NEAR(e1, exact.energy, tolerance) << where;
+        EXPECT_NEAR(energy[l], e1, agree) << where;
         for (int a = 0, p = 0; a < r; ++a) {
-          EXPECT_NEAR(f1[a], exact.gradient[a], tolerance) << "r = " << r << ", a = " << a;
-          EXPECT_NEAR(f[l][a], exact.gradient[a], tolerance) << "r = " << r << ", lane " << l << ", a = " << a;
+          EXPECT_NEAR(f1[a], exact.gradient[a], tolerance) << where << ", a = " << a;
+          EXPECT_NEAR(f[l][a], f1[a], agree) << where << ", a = " << a;
           for (int b = a; b < r; ++b, ++p) {
-            EXPECT_NEAR(K1[a * r + b], exact.hessian[a * r + b], tolerance) << "r = " << r << ", K" << a << b;
-            EXPECT_NEAR(lanes[p * L + l], exact.hessian[a * r + b], tolerance)
-                << "r = " << r << ", lane " << l << ", K" << a << b;
+            EXPECT_NEAR(K1[a * r + b], exact.hessian[a * r + b], tolerance) << where << ", K" << a << b;
+            EXPECT_NEAR(lanes[p * L + l], K1[a * r + b], agree) << where << ", K" << a << b;
           }
         }
       }

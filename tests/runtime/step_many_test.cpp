@@ -357,6 +357,38 @@ TEST(StepMany, OtherIntegratorsAndLoneInstancesStepAsAlone) {
   for (int i = 0; i < 4; ++i) EXPECT_EQ(batched.state(i), single.state(i)) << "instance " << i;
 }
 
+TEST(StepMany, ModelsWithoutTheGroupLayoutStepTheirInstancesAlone) {
+  quiver::test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  qv_model_destroy(m.model);
+  qv_model_config plain;
+  qv_model_config_init(&plain);
+  plain.group_layout = 0;
+  m.model = nullptr;
+  ASSERT_EQ(qv_model_load_file(QUIVER_RUNTIME_MODEL, &plain, nullptr, &m.model, nullptr, 0), QV_OK);
+  for (qv_solver solver : {QV_SOLVER_NEWTON, QV_SOLVER_MINIMIZE}) {
+    qv_instance_config config;
+    qv_instance_config_init(&config, m.model);
+    config.solver = solver;
+    Crowd batched(m, config, 9), single(m, config, 9);
+    size_t bytes = 0;
+    Scratch scratch = scratchFor(m.model, 1, bytes);
+    for (int step = 0; step < 30; ++step) {
+      batched.load(step);
+      single.load(step);
+      ASSERT_EQ(qv_instances_step(batched.instances.data(), 9, nullptr, scratch.get(), bytes, nullptr), QV_OK);
+      for (qv_instance* s : single.instances) qv_instance_step(s);
+    }
+    for (int i = 0; i < 9; ++i) EXPECT_EQ(batched.state(i), single.state(i)) << qv_solver_name(solver) << ", instance " << i;
+  }
+  for (int bad : {-2, 2}) {
+    plain.group_layout = bad;
+    qv_model* refused = nullptr;
+    EXPECT_EQ(qv_model_load_file(QUIVER_RUNTIME_MODEL, &plain, nullptr, &refused, nullptr, 0), QV_ERROR_INVALID_ARGUMENT);
+    EXPECT_EQ(refused, nullptr);
+  }
+}
+
 TEST(StepMany, BadArgumentsAreRefused) {
   quiver::test::TestModel m;
   ASSERT_NE(m.model, nullptr);
