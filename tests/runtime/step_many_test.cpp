@@ -72,6 +72,21 @@ void runOnThreads(void*, qv_job_function job, void* data, int count) {
   for (auto& t : threads) t.join();
 }
 
+// 30 steps of `batched` in one qv_instances_step call each and of `single` one by one, under the
+// same loads: the same bits, as when every instance steps alone.
+void expectOneByOneBits(const qv_model* model, Crowd& batched, Crowd& single, const std::string& label) {
+  size_t bytes = 0;
+  Scratch scratch = scratchFor(model, 1, bytes);
+  const int count = static_cast<int>(batched.instances.size());
+  for (int step = 0; step < 30; ++step) {
+    batched.load(step);
+    single.load(step);
+    ASSERT_EQ(qv_instances_step(batched.instances.data(), count, nullptr, scratch.get(), bytes, nullptr), QV_OK);
+    for (qv_instance* s : single.instances) qv_instance_step(s);
+  }
+  for (int i = 0; i < count; ++i) EXPECT_EQ(batched.state(i), single.state(i)) << label << ", instance " << i;
+}
+
 // evaluateLanes() with each state's K unpacked from the group's packed lanes into its r x r matrix.
 void evaluateGroup(const quiver::rt::ReducedPolynomial& poly, const double* const* q, int count, double* energy,
                    double* const* force, double* const* K, double* scratch) {
@@ -346,15 +361,7 @@ TEST(StepMany, OtherIntegratorsAndLoneInstancesStepAsAlone) {
   Crowd lone(m, newmark, 1), loneSingle(m, newmark, 1);
   batched.instances.push_back(lone.instances[0]);  // one Newmark instance among Euler ones: a group of one
   single.instances.push_back(loneSingle.instances[0]);
-  size_t bytes = 0;
-  Scratch scratch = scratchFor(m.model, 1, bytes);
-  for (int step = 0; step < 30; ++step) {
-    batched.load(step);
-    single.load(step);
-    ASSERT_EQ(qv_instances_step(batched.instances.data(), 4, nullptr, scratch.get(), bytes, nullptr), QV_OK);
-    for (qv_instance* s : single.instances) qv_instance_step(s);
-  }
-  for (int i = 0; i < 4; ++i) EXPECT_EQ(batched.state(i), single.state(i)) << "instance " << i;
+  expectOneByOneBits(m.model, batched, single, "Euler and a lone Newmark");
 }
 
 TEST(StepMany, ModelsWithoutTheGroupLayoutStepTheirInstancesAlone) {
@@ -371,15 +378,7 @@ TEST(StepMany, ModelsWithoutTheGroupLayoutStepTheirInstancesAlone) {
     qv_instance_config_init(&config, m.model);
     config.solver = solver;
     Crowd batched(m, config, 9), single(m, config, 9);
-    size_t bytes = 0;
-    Scratch scratch = scratchFor(m.model, 1, bytes);
-    for (int step = 0; step < 30; ++step) {
-      batched.load(step);
-      single.load(step);
-      ASSERT_EQ(qv_instances_step(batched.instances.data(), 9, nullptr, scratch.get(), bytes, nullptr), QV_OK);
-      for (qv_instance* s : single.instances) qv_instance_step(s);
-    }
-    for (int i = 0; i < 9; ++i) EXPECT_EQ(batched.state(i), single.state(i)) << qv_solver_name(solver) << ", instance " << i;
+    expectOneByOneBits(m.model, batched, single, qv_solver_name(solver));
   }
   for (int bad : {-2, 2}) {
     plain.group_layout = bad;
