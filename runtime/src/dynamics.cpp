@@ -18,12 +18,12 @@ void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales&
                                  (i == j ? scales.identity : 0.0);
 }
 
-QV_HOT void dampingForces(const qv_instance& s, const double* v, double* out) {
+QV_HOT void dampingForces(const qv_instance& s, const double* K, const double* v, double* out) {
   const int r = s.r;
   const double alpha = s.config.rayleigh_alpha, beta = s.config.rayleigh_beta;
   for (int i = 0; i < r; ++i) out[i] = alpha * v[i];
   for (int j = 0; j < r; ++j) {
-    const double* Kj = s.work.stiffness + j * r;
+    const double* Kj = K + j * r;
     const double vj = v[j];
 #pragma omp simd
     for (int i = 0; i < r; ++i) out[i] += beta * Kj[i] * vj;

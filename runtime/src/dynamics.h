@@ -16,9 +16,13 @@ void elasticityAt(qv_instance& s, const double* q, double* energy, double* force
 // Fills s.work.force = R(q) + S(q) and s.work.stiffness = K(q); returns J.
 const double* evaluateForces(qv_instance& s, const double* q);
 
-// C v = alpha v + beta K v into `out` (r values), with the elastic stiffness last evaluated: K is
-// symmetric, so the product runs along its rows as axpys (SIMD across i), each sum over j in order.
-void dampingForces(const qv_instance& s, const double* v, double* out);
+// C v = alpha v + beta K v into `out` (r values), K the elastic stiffness last evaluated (or, for
+// the minimising solver's C0, K(0)): K is symmetric, so the product runs along its rows as axpys
+// (SIMD across i), each sum over j in order, instead of r chains of r dependent multiply-adds.
+void dampingForces(const qv_instance& s, const double* K, const double* v, double* out);
+inline void dampingForces(const qv_instance& s, const double* v, double* out) {
+  dampingForces(s, s.work.stiffness, v, out);
+}
 
 // The fixed Newton step's (I + c1 C + c2 (K + J)), C = alpha I + beta K(q). Fused explicitly: the
 // group and the solver compute it in code built for different instruction sets, and a group's

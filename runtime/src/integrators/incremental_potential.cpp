@@ -34,8 +34,9 @@ public:
     pt.jacobian = s_.loads.addStateForces(x, s_.work.force, &S);
     double inertia = 0, external = 0, damping = 0, inertiaNorm = 0, forceNorm = 0, externalNorm = 0, dampingNorm = 0;
     for (int i = 0; i < r_; ++i) velocity_[i] = v0_[i] + p_.s * (x[i] - qt_[i]);
+    dampingForces(s_, s_.model->restStiffness, velocity_, s_.work.damping);
     for (int i = 0; i < r_; ++i) {
-      const double d = x[i] - qt_[i], f = s_.loads.external(i), cv = restDampingForce(s_, i, velocity_);
+      const double d = x[i] - qt_[i], f = s_.loads.external(i), cv = s_.work.damping[i];
       inertia += d * d;
       external += f * x[i];
       damping += velocity_[i] * cv;
@@ -133,12 +134,6 @@ void holdToBudget(qv_instance& s, double budget, double* x, double* velocity, do
 
 } // namespace
 
-double restDampingForce(const qv_instance& s, int i, const double* v) {
-  double c = s.config.rayleigh_alpha * v[i];
-  for (int j = 0; j < s.r; ++j) c += s.config.rayleigh_beta * s.model->restStiffness[i * s.r + j] * v[j];
-  return c;
-}
-
 void MinimizeTask::begin(qv_instance& s, const StepPredictor& p) {
   s_ = &s;
   p_ = p;
@@ -233,7 +228,8 @@ void MinimizeTask::finish() {
   // Damping's share: h v_mid^T C0 v_mid, exact for the trapezoidal rule's linear damping.
   double* mid = s.work.midpointVelocity;
   for (int i = 0; i < r; ++i) mid[i] = 0.5 * (s.v[i] + s.end.v[i]);
-  for (int i = 0; i < r; ++i) budget_ -= p_.h * mid[i] * restDampingForce(s, i, mid);
+  dampingForces(s, s.model->restStiffness, mid, s.work.damping);
+  for (int i = 0; i < r; ++i) budget_ -= p_.h * mid[i] * s.work.damping[i];
   holdToBudget(s, budget_, s.end.q, s.end.v, elastic_, s.lastStep);
   // A step held back forfeits the slack: what it removed is not to be won back.
   s.energySlack = s.lastStep.held_back ? 0.0 : std::fmax(0.0, budget_ - stepEnergy(s, s.end.q, s.end.v, elastic_));

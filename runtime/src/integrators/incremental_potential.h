@@ -28,9 +28,6 @@ struct StepPredictor {
   double h;  // the time step
 };
 
-// (C0 v)_i, C0 = alpha I + beta K(0).
-double restDampingForce(const qv_instance& s, int i, const double* v);
-
 // Phi's Hessian w I + K(x) + J + s C0, the matrix of each Newton direction (before any shift);
 // fused explicitly, as newtonSystem() (dynamics.h).
 inline SystemScales minimizerSystem(const qv_instance& s, const StepPredictor& p) {
