@@ -31,8 +31,7 @@ struct SystemScales {
 // What one evaluation at a trial state fills, and the Newton system built from it.
 struct StepBuffers {
   double* force = nullptr;        // R(q) plus the state forces (resisting: the step subtracts it)
-  double* stiffness = nullptr;    // K(q), elastic only (Rayleigh damping uses it); after a group's
-                                  // evaluation for a minimising step, its upper triangle only
+  double* stiffness = nullptr;    // K(q), elastic only (Rayleigh damping uses it)
   double* system = nullptr;       // the Newton matrix, factorised in place
   double* correction = nullptr;   // the Newton right-hand side in, the correction out
   double* damping = nullptr;      // C v (dampingForces(), dynamics.h)

@@ -27,13 +27,18 @@ bool groupable(const qv_instance& s) {
 // the state forces' Jacobian depends on q (elsewhere it is the constraints' constant one).
 bool factorisedInGroup(const qv_instance& s) { return !s.flying(); }
 
-// Copies the upper triangles of the group's packed lanes (evaluateLanes()'s layout) into the members'
-// row-major r x r matrices, row by row: a row's lanes are one short contiguous run.
-QV_HOT void unpackUpper(const double* lanes, int r, int count, double* const* out) {
+// Copies the group's symmetric matrices, packed by lane (evaluateLanes()'s layout), into the
+// members' whole row-major r x r matrices, each output row written in order: its lower part from
+// the column above the diagonal, its upper part from the packed row (one short contiguous run of
+// lanes per entry).
+QV_HOT void unpackSymmetric(const double* lanes, int r, int count, double* const* out) {
   for (int a = 0; a < r; ++a) {
     const double* row = lanes + (packedUpperIndex(r, a, a) - static_cast<size_t>(a)) * kLanes;
-    for (int l = 0; l < count; ++l)
-      for (int b = a; b < r; ++b) out[l][a * r + b] = row[b * kLanes + l];
+    for (int l = 0; l < count; ++l) {
+      double* K = out[l] + a * r;
+      for (int b = 0; b < a; ++b) K[b] = lanes[packedUpperIndex(r, b, a) * kLanes + l];
+      for (int b = a; b < r; ++b) K[b] = row[b * kLanes + l];
+    }
   }
 }
 
@@ -81,8 +86,7 @@ QV_HOT void factoriseGroup(qv_instance* const* group, int count, const SystemSca
 }
 
 // Evaluates the members' polynomials together at their presetAt points and leaves each one's
-// preset for its step's next evaluation there: R(q) and E(q), K(q)'s upper triangle in its
-// `stiffness` (all the minimiser reads); returns the group's K packed by lane (evaluateLanes()) in
+// preset for its step's next evaluation there: R(q) and E(q), K(q) in its `stiffness`; returns the group's K packed by lane (evaluateLanes()) in
 // `scratch`.
 QV_HOT double* evaluateTogether(qv_instance* const* members, int count, double* scratch) {
   const int r = members[0]->r;
@@ -97,7 +101,7 @@ QV_HOT double* evaluateTogether(qv_instance* const* members, int count, double* 
     stiffness[l] = members[l]->work.stiffness;
   }
   members[0]->model->polynomial.evaluateLanes(at, count, energy, force, stiffnessLanes, scratch + pairs(r) * kLanes);
-  unpackUpper(stiffnessLanes, r, count, stiffness);
+  unpackSymmetric(stiffnessLanes, r, count, stiffness);
   for (int l = 0; l < count; ++l) {
     members[l]->work.presetEnergy = energy[l];
     members[l]->work.presetValid = true;
@@ -121,12 +125,6 @@ void stepNewtonGroup(qv_instance* const* group, const int* index, int count, dou
     scales[l] = newtonSystem(*group[l], c1, c2);
   }
   factoriseGroup(group, count, scales, evaluateTogether(group, count, scratch));
-  for (int l = 0; l < count; ++l) {  // K's lower half too: damping and the LU fallback read whole rows
-    double* K = group[l]->work.stiffness;
-    const int r = group[l]->r;
-    for (int a = 0; a < r; ++a)
-      for (int b = a + 1; b < r; ++b) K[b * r + a] = K[a * r + b];
-  }
   for (int l = 0; l < count; ++l) {
     const qv_step_status status = group[l]->finishStep();
     if (statuses) statuses[index[l]] = status;
