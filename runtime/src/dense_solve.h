@@ -47,18 +47,11 @@ inline void choleskySubstitute(const Factor& U, double* b, int n) {
     b[i] /= rowI[i * S];
     for (int k = i + 1; k < n; ++k) b[k] -= rowI[k * S] * b[i];
   }
-  for (int i = n - 1; i >= 0; --i) {  // U x = y; each row's sum in four parts, so that it does not
-    const double* rowI = U.row(i);     // wait on the latency of every multiply-add in turn
-    double s0 = b[i], s1 = 0, s2 = 0, s3 = 0;
-    int k = i + 1;
-    for (; k + 4 <= n; k += 4) {
-      s0 -= rowI[k * S] * b[k];
-      s1 -= rowI[(k + 1) * S] * b[k + 1];
-      s2 -= rowI[(k + 2) * S] * b[k + 2];
-      s3 -= rowI[(k + 3) * S] * b[k + 3];
-    }
-    for (; k < n; ++k) s0 -= rowI[k * S] * b[k];
-    b[i] = ((s0 + s1) + (s2 + s3)) / rowI[i * S];
+  for (int i = n - 1; i >= 0; --i) {  // U x = y
+    const double* rowI = U.row(i);
+    double s = b[i];
+    for (int k = i + 1; k < n; ++k) s -= rowI[k * S] * b[k];
+    b[i] = s / rowI[i * S];
   }
 }
 
