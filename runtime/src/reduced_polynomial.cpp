@@ -32,8 +32,6 @@ double repeatFactor(const int (&idx)[N]) {
 
 size_t align8(size_t n) { return n & ~size_t(7); }
 
-// Rows padded to whole blocks (ReducedPolynomial::kBlock = 8).
-size_t blockedRows(size_t rows) { return (rows + 7) & ~size_t(7); }
 
 size_t packedCount(size_t pairs) {
   size_t total = 0;

@@ -43,7 +43,8 @@ public:
   // Rows of r coefficients, blocked eight rows at a time ([block][k][8]) so that one row block
   // times q is one vector of eight sums per k.
   static constexpr int kBlock = 8;
-  // Where entry (i, k) of a blocked matrix of r columns sits.
+  // Rows padded to whole blocks, and where entry (i, k) of a blocked matrix of r columns sits.
+  static size_t blockedRows(size_t rows) { return (rows + kBlock - 1) / kBlock * kBlock; }
   static size_t blockedAt(int r, size_t i, int k) {
     return (i / kBlock * r + static_cast<size_t>(k)) * kBlock + i % kBlock;
   }

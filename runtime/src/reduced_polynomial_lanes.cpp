@@ -87,9 +87,9 @@ QV_HOT void gatheredProductLanes(const double* U, const uint32_t* tripleOf, int 
 } // namespace
 
 size_t ReducedPolynomial::laneScratchSize(int r) {
-  return (((monomialCount3(r) + 7) & ~size_t(7)) + ((monomialCount2(r) + 7) & ~size_t(7)) + monomialCount2(r) +
-          3 * static_cast<size_t>(r) + 1) *
-         L;
+  const size_t perLane =
+      blockedRows(monomialCount3(r)) + blockedRows(monomialCount2(r)) + monomialCount2(r) + 3 * static_cast<size_t>(r) + 1;
+  return perLane * L;
 }
 
 QV_HOT void ReducedPolynomial::evaluateLanes(const double* const* q, int count, double* energy, double* const* force,
@@ -97,8 +97,8 @@ QV_HOT void ReducedPolynomial::evaluateLanes(const double* const* q, int count, 
   const int r = r_;
   const size_t P = pairs_;
   double* u = scratch;  // [triple][lane]: U_ijk (reduced_polynomial.h)
-  double* y3 = u + ((triples_ + 7) & ~size_t(7)) * L;
-  double* y4 = y3 + ((P + 7) & ~size_t(7)) * L;
+  double* y3 = u + blockedRows(triples_) * L;
+  double* y4 = y3 + blockedRows(P) * L;
   double* ql = y4 + P * L;  // [k][lane]: q, zero in unused lanes
   double* Rq = ql + static_cast<size_t>(r) * L;
   double* e = Rq + static_cast<size_t>(r) * L;

@@ -86,8 +86,8 @@ QV_HOT void factoriseGroup(qv_instance* const* group, int count, const SystemSca
 }
 
 // Evaluates the members' polynomials together at their presetAt points and leaves each one's
-// preset for its step's next evaluation there: R(q) and E(q), K(q) in its `stiffness`; returns the group's K packed by lane (evaluateLanes()) in
-// `scratch`.
+// preset for its step's next evaluation there: R(q) and E(q), K(q) in its `stiffness`; returns
+// the group's K packed by lane (evaluateLanes()) in `scratch`.
 QV_HOT double* evaluateTogether(qv_instance* const* members, int count, double* scratch) {
   const int r = members[0]->r;
   double* stiffnessLanes = scratch;  // [pair][lane]
