@@ -182,6 +182,7 @@ void stepMinimizingTogether(qv_instance* const* instances, Next next, double* sc
 } // namespace
 
 size_t stepManyScratchPerJob(const qv_model& model) {
+  if (!model.polynomial.groups()) return 64;  // nothing is stepped in groups: one line, never read
   const int r = model.info.r;
   const size_t doubles = pairs(r) * kLanes + ReducedPolynomial::laneScratchSize(r);
   return (doubles * sizeof(double) + 63) & ~size_t(63);

@@ -373,6 +373,8 @@ TEST(StepMany, ModelsWithoutTheGroupLayoutStepTheirInstancesAlone) {
   plain.group_layout = 0;
   m.model = nullptr;
   ASSERT_EQ(qv_model_load_file(QUIVER_RUNTIME_MODEL, &plain, nullptr, &m.model, nullptr, 0), QV_OK);
+  // No group scratch either: the crowds below step in the one line asked for each job.
+  EXPECT_LE(qv_instances_step_scratch_size(m.model, 2), 128u);
   for (qv_solver solver : {QV_SOLVER_NEWTON, QV_SOLVER_MINIMIZE}) {
     qv_instance_config config;
     qv_instance_config_init(&config, m.model);
