@@ -4,8 +4,6 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
-#include <sstream>
-#include <string_view>
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -13,6 +11,7 @@
 
 #include "common/mesh_error.h"
 #include "common/surface.h"
+#include "formats/mesh/own_readers.h"
 #include "formats/mesh/read_mesh.h"
 
 namespace quiver {
@@ -27,45 +26,40 @@ SurfaceMesh tetBoundary(const std::string& path) {
   return s;
 }
 
-// Assimp's OFF and PLY importers allocate what their headers count before reading on: a few
-// corrupt bytes ("OFF 8 611111111111") would ask for gigabytes. Counts a file of this size cannot
-// hold are refused here first (an element takes at least one byte; an OFF vertex at least 6).
-void checkHeaderCounts(std::string_view bytes, const std::string& extension, const std::string& name) {
-  std::string ext = extension;
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  const auto refuse = [&](const std::string& what) {
-    throw MeshError(name + ": the header counts " + what + ", more than its " + std::to_string(bytes.size()) + " bytes can hold");
-  };
-  std::istringstream in(std::string(bytes.substr(0, 65536)));
-  std::string word;
-  if (ext == "off") {
-    double vertices = 0, faces = 0;  // after OFF (or COFF, NOFF, ...); anything else the importer judges
-    if (!(in >> word) || word.find("OFF") == std::string::npos || !(in >> vertices >> faces)) return;
-    if (6 * vertices + faces > double(bytes.size()))
-      refuse(std::to_string(static_cast<long long>(std::fmin(vertices, 9e18))) + " vertices and " +
-             std::to_string(static_cast<long long>(std::fmin(faces, 9e18))) + " faces");
-  } else if (ext == "ply") {
-    double total = 0;
-    for (std::string line; std::getline(in, line) && line.rfind("end_header", 0) != 0;) {
-      std::istringstream fields(line);
-      std::string keyword, element;
-      double count = 0;
-      if (fields >> keyword >> element >> count && keyword == "element" && count > 0) total += count;
-    }
-    if (total > double(bytes.size())) refuse(std::to_string(static_cast<long long>(std::fmin(total, 9e18))) + " elements");
-  }
-}
-
 // Points and lines are dropped by the importer; what remains is triangles, checked.
 constexpr unsigned kSteps = aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType |
                             aiProcess_GenSmoothNormals | aiProcess_ValidateDataStructure;
 
-void configure(Assimp::Importer& importer) {
+void configure(Assimp::Importer& importer, const std::string& name) {
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  useOwnReaders(importer, name);
+}
+
+// Assimp triangulates a polygon in time quadratic in its corners (a 16 000-gon took 3.4 s, so a
+// 250 000-gon would take about 15 minutes): polygons past kMaxCorners are refused before it does.
+// The import itself validates the scene (Assimp does that before anything else reads it: indices
+// out of range crashed its scene preprocessing), then the polygons are counted, then kSteps run.
+constexpr unsigned kMaxCorners = 4096;
+constexpr unsigned kImport = aiProcess_ValidateDataStructure;
+
+const aiScene* postProcess(Assimp::Importer& importer, const aiScene* imported, const std::string& path) {
+  if (!imported) return nullptr;
+  for (unsigned m = 0; m < imported->mNumMeshes; ++m) {
+    const aiMesh* mesh = imported->mMeshes[m];
+    for (unsigned f = 0; mesh && mesh->mFaces && f < mesh->mNumFaces; ++f)
+      if (mesh->mFaces[f].mNumIndices > kMaxCorners)
+        throw MeshError(path + ": mesh " + std::to_string(m) + ", face " + std::to_string(f) + " has " +
+                        std::to_string(mesh->mFaces[f].mNumIndices) + " corners, more than the " + std::to_string(kMaxCorners) +
+                        " read here (triangulate it before export)");
+  }
+  return importer.ApplyPostProcessing(kSteps);
 }
 
 SurfaceMesh fromScene(const aiScene* scene, const Assimp::Importer& importer, const std::string& path) {
-  if (!scene || !scene->mRootNode) throw MeshError(path + ": cannot read: " + importer.GetErrorString());
+  if (!scene || !scene->mRootNode) {
+    const std::string error = importer.GetErrorString();  // our readers' (own_readers.h) already name the file
+    throw MeshError(error.rfind(path + ":", 0) == 0 ? error : path + ": cannot read: " + error);
+  }
   SurfaceMesh s;
   std::map<std::array<double, 3>, int> welded;
   bool anyUVs = false;
@@ -120,20 +114,16 @@ bool isTetMeshPath(const std::string& path) {
 SurfaceMesh readSurfaceFile(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw MeshError(path + ": cannot open: no such file");
   if (isTetMeshPath(path)) return tetBoundary(path);
-  std::string extension = std::filesystem::path(path).extension().string();
-  if (!extension.empty()) extension.erase(0, 1);
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (extension == "off" || extension == "ply") checkHeaderCounts(readFileBytes(path), extension, path);
   Assimp::Importer importer;
-  configure(importer);
-  return fromScene(importer.ReadFile(path, kSteps), importer, path);
+  configure(importer, path);
+  return fromScene(postProcess(importer, importer.ReadFile(path, kImport), path), importer, path);
 }
 
 SurfaceMesh readSurfaceMemory(const void* data, size_t size, const std::string& extension, const std::string& name) {
-  checkHeaderCounts(std::string_view(static_cast<const char*>(data), size), extension, name);
   Assimp::Importer importer;
-  configure(importer);
-  return fromScene(importer.ReadFileFromMemory(data, size, kSteps, extension.c_str()), importer, name);
+  configure(importer, name);
+  return fromScene(postProcess(importer, importer.ReadFileFromMemory(data, size, kImport, extension.c_str()), name), importer,
+                   name);
 }
 
 } // namespace quiver

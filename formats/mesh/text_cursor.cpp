@@ -9,6 +9,18 @@ namespace {
 bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v'; }
 } // namespace
 
+std::vector<std::string_view> words(std::string_view line) {
+  std::vector<std::string_view> out;
+  size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && isSpace(line[i])) ++i;
+    const size_t start = i;
+    while (i < line.size() && !isSpace(line[i])) ++i;
+    if (i > start) out.push_back(line.substr(start, i - start));
+  }
+  return out;
+}
+
 std::string printableToken(std::string_view token) {
   std::string out;
   for (char c : token.substr(0, 40)) out += (c >= 32 && c < 127) ? c : '?';

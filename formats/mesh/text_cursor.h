@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "common/mesh_error.h"
 
@@ -48,6 +49,9 @@ private:
   int line_ = 1;
   int tokenLine_ = 1;
 };
+
+// A line's whitespace-separated words.
+std::vector<std::string_view> words(std::string_view line);
 
 // A token from the file made safe for a message: at most 40 characters, non-printable ones as '?'.
 std::string printableToken(std::string_view token);

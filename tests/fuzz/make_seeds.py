@@ -142,9 +142,17 @@ def write_surface_seeds():
     ply = ("ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
            "element face 6\nproperty list uchar int vertex_indices\nend_header\n")
     ply += "".join(f"{x} {y} {z}\n" for x, y, z in corners) + "".join("4 " + " ".join(map(str, q)) + "\n" for q in quads)
+    ply_binary = ("ply\nformat binary_big_endian 1.0\nelement vertex 8\nproperty double x\nproperty double y\n"
+                  "property double z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float s\n"
+                  "property float t\nelement face 6\nproperty list uchar uint vertex_indices\nend_header\n").encode()
+    ply_binary += b"".join(struct.pack(">3d5f", x, y, z, 0, 0, 1, x, y) for x, y, z in corners)
+    ply_binary += b"".join(struct.pack(">B4I", 4, *q) for q in quads)
+    off_prefixed = "STCNOFF\n8 6 0\n" + "".join(f"{x} {y} {z} 0 0 1 0.5 0.5 0.5 {x} {y}\n" for x, y, z in corners)
+    off_prefixed += "".join("4 " + " ".join(map(str, q)) + " 255 0 0\n" for q in quads)
     off = "OFF\n8 6 0\n" + "".join(f"{x} {y} {z}\n" for x, y, z in corners) + "".join("4 " + " ".join(map(str, q)) + "\n" for q in quads)
     for name, kind, data in (("cube.obj", 0, obj.encode()), ("cube_ascii.stl", 1, stl.encode()), ("cube_binary.stl", 1, binary),
-                             ("cube.ply", 2, ply.encode()), ("cube.off", 3, off.encode())):
+                             ("cube.ply", 2, ply.encode()), ("cube_binary.ply", 2, ply_binary),
+                             ("cube.off", 3, off.encode()), ("cube_prefixed.off", 3, off_prefixed.encode())):
         open(write("surface", name), "wb").write(bytes([kind]) + data)
 
 
