@@ -44,6 +44,7 @@ int RuntimeTarget::step(int& newton) {
   newton = report.newton_iterations;
   indefinite_ += status == QV_STEP_INDEFINITE;
   heldBack_ += report.held_back;
+  minimized_ += report.minimized;
   energyRemoved_ += report.energy_removed;
   if (flight_)
     for (const qv_contact& c : flight_->contacts()) maxPenetration_ = std::max(maxPenetration_, -c.depth);

@@ -31,13 +31,14 @@ public:
   const FlightWorld* flight() const { return flight_.get(); }
   int indefiniteSteps() const { return indefinite_; }
   int heldBackSteps() const { return heldBack_; }
+  int minimizedSteps() const { return minimized_; }  // fixed Newton steps the minimiser took
   double energyRemoved() const { return energyRemoved_; }  // J, by the minimising solver's energy budget
   double maxPenetration() const { return maxPenetration_; }  // m, the deepest contact seen
 
 private:
   const RuntimeModel& model_;
   RuntimeInstance instance_;
-  int indefinite_ = 0, heldBack_ = 0;
+  int indefinite_ = 0, heldBack_ = 0, minimized_ = 0;
   double energyRemoved_ = 0;
   std::unique_ptr<FlightWorld> flight_;
   double maxPenetration_ = 0;

@@ -74,7 +74,7 @@ int simulateCrowd(const std::string& path, const SimOptions& o, const CrowdOptio
   std::unique_ptr<void, AlignedFree> scratch(std::aligned_alloc(64, (bytes + 63) / 64 * 64));
   std::vector<qv_step_status> statuses(n);
   std::vector<double> frameMs;
-  long resets = 0;
+  long resets = 0, minimized = 0;
   for (int step = 0; step < o.steps; ++step) {
     if (step < o.holdSteps)
       for (int k = 0; k < n; ++k)
@@ -88,6 +88,11 @@ int simulateCrowd(const std::string& path, const SimOptions& o, const CrowdOptio
     }
     frameMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
     for (qv_step_status s : statuses) resets += s == QV_STEP_RESET;
+    for (qv_instance* s : instances) {
+      qv_step_report report;
+      qv_instance_last_step(s, &report);
+      minimized += report.minimized;
+    }
   }
   const double median = percentile(frameMs, 0.5), p99 = percentile(frameMs, 0.99);
   if (o.json) {
@@ -104,6 +109,7 @@ int simulateCrowd(const std::string& path, const SimOptions& o, const CrowdOptio
     j["frame_ms_p99"] = p99;
     j["instance_step_us_median"] = 1e3 * median / n;
     j["resets"] = resets;
+    j["minimized_steps"] = minimized;  // fixed Newton steps the minimiser took
     std::cout << j.dump(1) << "\n";
   } else {
     std::cout << "quiver sim: " << n << " instances of r = " << model.info().r << ", " << o.steps << " frames "

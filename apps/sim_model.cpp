@@ -31,6 +31,7 @@ int simulateModel(const std::string& path, const SimOptions& o) {
     j["indefinite_steps"] = target.indefiniteSteps();
     j["newton_iterations_mean"] = static_cast<double>(result.newtonIterations) / o.steps;
     j["held_back_steps"] = target.heldBackSteps();
+    j["minimized_steps"] = target.minimizedSteps();
     j["energy_removed_J"] = target.energyRemoved();
     qv_rigid_state flight;
     if (qv_instance_get_rigid_state(target.instance().get(), &flight) == QV_OK) {

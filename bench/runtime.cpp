@@ -124,8 +124,11 @@ void Evaluate(benchmark::State& state, const char* path, bool withStiffness, int
   qv_model_destroy(m.model);
 }
 
-// Gravity, plus twice its pull on the first coordinate flipping every half second, so that every
-// step has work to do (a settled object converges at once and would flatter the solver).
+// Gravity, plus a tenth of its pull on the first coordinate flipping every quarter second, so that
+// every step has work to do (a settled object converges at once and would flatter the minimiser),
+// within the strains the fixed Newton step is made for: twice the pull, flipping every half second,
+// bent the soft bar so far that its Newton systems were indefinite in 9 steps of 10 at r = 30, and
+// the minimiser now takes those (`minimized`, the share of fixed Newton steps it took).
 void Step(benchmark::State& state, const char* path, qv_solver solver, int precision) {
   Loaded m(path, precision);
   qv_instance_config config;
@@ -137,19 +140,21 @@ void Step(benchmark::State& state, const char* path, qv_solver solver, int preci
   const double g[3] = {0, 0, -QV_STANDARD_GRAVITY};
   qv_instance_set_gravity(s, g);
   std::vector<double> push(m.info.r, 0.0);
-  const double amplitude = 2 * QV_STANDARD_GRAVITY * std::fabs(qv_model_gravity(m.model)[2 * m.info.r]);
-  long steps = 0, iterations = 0;
+  const double amplitude = 0.1 * QV_STANDARD_GRAVITY * std::fabs(qv_model_gravity(m.model)[2 * m.info.r]);
+  long steps = 0, iterations = 0, minimized = 0;
   for (auto _ : state) {
-    push[0] = (steps / 30) % 2 ? amplitude : -amplitude;
+    push[0] = (steps / 15) % 2 ? amplitude : -amplitude;
     qv_instance_add_reduced_force(s, push.data());
     qv_instance_step(s);
     qv_step_report report;
     qv_instance_last_step(s, &report);
     iterations += report.newton_iterations;
+    minimized += report.minimized;
     ++steps;
   }
   state.counters["r"] = m.info.r;
   state.counters["newton_per_step"] = static_cast<double>(iterations) / static_cast<double>(steps);
+  state.counters["minimized"] = static_cast<double>(minimized) / static_cast<double>(steps);
   state.SetLabel("state " + stateHash(s, m.info.r));
   qv_instance_destroy(s);
   qv_model_destroy(m.model);
@@ -157,8 +162,7 @@ void Step(benchmark::State& state, const char* path, qv_solver solver, int preci
 
 // `objects` instances of one model per frame, each under its own push on the first coordinate (0.1
 // to 0.2 times what gravity puts there, flipping every quarter second, out of phase from one
-// instance to the next; flipping every half second drove the soft bar near resonance, and the fixed
-// Newton step reset now and then), stepped one by one (qv_instance_step) or in one call
+// instance to the next: the load of Step, spread), stepped one by one (qv_instance_step) or in one call
 // (qv_instances_step: groups of 8 evaluated together).
 void ManyObjects(benchmark::State& state, const char* path, qv_solver solver, bool together) {
   Loaded m(path);
@@ -174,7 +178,7 @@ void ManyObjects(benchmark::State& state, const char* path, qv_solver solver, bo
   const double amplitude = 0.1 * QV_STANDARD_GRAVITY * std::fabs(qv_model_gravity(m.model)[2 * r]);
   std::vector<double> push(r, 0.0);
   std::vector<qv_step_status> statuses(objects);
-  long frame = 0, resets = 0;
+  long frame = 0, resets = 0, minimized = 0;
   for (auto _ : state) {
     for (int i = 0; i < objects; ++i) {
       push[0] = (1 + (i % 11) / 10.0) * (((frame + i) / 15) % 2 ? amplitude : -amplitude);
@@ -186,10 +190,16 @@ void ManyObjects(benchmark::State& state, const char* path, qv_solver solver, bo
     } else {
       for (auto* s : all) resets += qv_instance_step(s) == QV_STEP_RESET;
     }
+    for (auto* s : all) {
+      qv_step_report report;
+      qv_instance_last_step(s, &report);
+      minimized += report.minimized;
+    }
     ++frame;
   }
   state.counters["r"] = r;
   state.counters["resets"] = static_cast<double>(resets);  // expected 0: a reset step is no measure
+  state.counters["minimized"] = static_cast<double>(minimized);  // fixed Newton steps the minimiser took
   state.SetLabel("state " + stateHash(all.back(), r));
   std::free(scratch);
   for (auto* s : all) qv_instance_destroy(s);

@@ -81,15 +81,17 @@ def main():
     cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")), "?")
     print(f"CPU: {cpu}; OpenBLAS core: {blas_core()}")
     print(f"Peak FMA throughput of this core, measured in the same run: {peak_gflops:.1f} GFLOP/s (double, its widest vectors)\n")
-    print("| r | force (us) | force + stiffness (us) | Newmark step, fixed Newton (us) | Vega-like step, same run (us) "
-          "| x Vega | Newmark step, minimise (us) | its Newton iterations | evaluation GFLOP/s | fraction of peak |")
-    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("| r | force (us) | force + stiffness (us) | Newmark step, fixed Newton (us) | its steps the minimiser took "
+          "| Vega-like step, same run (us) | x Vega | Newmark step, minimise (us) | its Newton iterations "
+          "| evaluation GFLOP/s | fraction of peak |")
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for r in RANKS:
         f, fk = get(f"Evaluate/force/r{r}"), get(f"Evaluate/force+stiffness/r{r}")
         newton, minimize = get(f"Step/newton/r{r}"), get(f"Step/minimize/r{r}")
         gflops = fk["GFLOPS"] / 1e9
         reference = vega.get(r, float("nan"))
-        print(f"| {r} | {f['real_time']:.2f} | {fk['real_time']:.2f} | {newton['real_time']:.2f} | {reference:.1f} | "
+        print(f"| {r} | {f['real_time']:.2f} | {fk['real_time']:.2f} | {newton['real_time']:.2f} | "
+              f"{newton['minimized']:.2%} | {reference:.1f} | "
               f"{reference / newton['real_time']:.1f} | {minimize['real_time']:.2f} | {minimize['newton_per_step']:.2f} | {gflops:.1f} | {gflops / peak_gflops:.0%} |")
     print("\nCoefficient precision and the memory floor (force + stiffness; *stream* reads the same bytes as "
           "doubles, same run):\n")
@@ -105,14 +107,16 @@ def main():
               f"{e32['real_time'] / s32['real_time']:.1f} | {e64['real_time'] / e32['real_time']:.2f} | "
               f"{n64['real_time']:.2f} | {n32['real_time']:.2f} |")
     print("\nMany objects: 1000 instances per frame on one core, each under its own push (bench/runtime.cpp):\n")
-    print("| r | solver | one by one (ms per frame) | qv_instances_step (ms per frame) | speed-up | resets |")
-    print("|---:|---|---:|---:|---:|---:|")
+    print("| r | solver | one by one (ms per frame) | qv_instances_step (ms per frame) | speed-up | resets "
+          "| fixed Newton steps the minimiser took |")
+    print("|---:|---|---:|---:|---:|---:|---:|")
     for r in (20, 30):
         for solver in ("newton", "minimize"):
             alone, together = get(f"ManyObjects/{solver}/one-by-one/r{r}/1000"), get(f"ManyObjects/{solver}/together/r{r}/1000")
             if alone and together:
                 print(f"| {r} | {solver} | {alone['real_time']:.2f} | {together['real_time']:.2f} | "
-                      f"{alone['real_time'] / together['real_time']:.2f} | {int(alone['resets'] + together['resets'])} |")
+                      f"{alone['real_time'] / together['real_time']:.2f} | {int(alone['resets'] + together['resets'])} | "
+                      f"{int(alone['minimized'] + together['minimized'])} |")
 
 
 if __name__ == "__main__":

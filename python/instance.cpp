@@ -311,8 +311,8 @@ colliders persist. Positions and normals are in the world (in flight, carried by
              return status;
            },
            py::arg("count") = 1, R"(Advances `count` time steps (each under the loads set so far; per-step loads are
-cleared after the first). Returns a StepStatus: OK, INDEFINITE (the system was shifted or pivoted) or
-RESET (the state blew up or ran away and was reset to rest), the worst of the steps taken.)")
+cleared after the first). Returns a StepStatus: OK, INDEFINITE (the minimiser shifted an indefinite system)
+or RESET (the state became non-finite and was reset to rest), the worst of the steps taken.)")
       .def_property_readonly("last_step", [](const Instance& self) {
         qv_step_report r;
         qv_instance_last_step(self.use(), &r);
@@ -323,6 +323,7 @@ RESET (the state blew up or ran away and was reset to rest), the worst of the st
         d["gradient"] = r.gradient;
         d["held_back"] = r.held_back != 0;
         d["energy_removed"] = r.energy_removed;
+        d["minimized"] = r.minimized != 0;
         return d;
       }, "what the last step did (qv_step_report), as a dict")
       .def_property("q", [](const Instance& self) { return statePart(self, Part::q); },

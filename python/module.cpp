@@ -149,8 +149,9 @@ PYBIND11_MODULE(_quiver, m) {
 
   py::enum_<qv_step_status>(m, "StepStatus", "What a step did (qv_step_status).")
       .value("OK", QV_STEP_OK)
-      .value("INDEFINITE", QV_STEP_INDEFINITE, "the system matrix was indefinite and was shifted or pivoted")
-      .value("RESET", QV_STEP_RESET, "the state became non-finite or ran away: the instance was reset to rest");
+      .value("INDEFINITE", QV_STEP_INDEFINITE, "the minimiser shifted a system matrix made indefinite by compression")
+      .value("RESET", QV_STEP_RESET,
+             "the state became non-finite (or central differences ran past max_displacement): reset to rest");
 
   bindModel(m);
   bindColliders(m);

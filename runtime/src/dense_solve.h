@@ -1,7 +1,7 @@
 #pragma once
-// In-place solves of the small dense r x r systems of implicit time stepping, with no allocation:
-// Cholesky for the usual symmetric positive definite case, pivoting LU when large compression has
-// made the stiffness indefinite.
+// In-place Cholesky solves of the small dense r x r systems of implicit time stepping, with no
+// allocation (a system that large compression made indefinite is the minimising solver's, which
+// shifts it).
 #include <cmath>
 #include <cstddef>
 
@@ -61,42 +61,6 @@ inline void choleskySubstitute(const Factor& U, double* b, int n) {
 inline bool choleskySolve(double* A, double* b, int n) {
   if (!choleskyFactor(A, n)) return false;
   choleskySubstitute(DenseFactor{A, n}, b, n);
-  return true;
-}
-
-// Solves A x = b by LU with partial pivoting (A row-major, overwritten; b overwritten by x;
-// `pivot` holds n ints). Returns false when A is singular to working precision.
-inline bool luSolve(double* A, double* b, int* pivot, int n) {
-  double largest = 0;
-  for (int i = 0; i < n * n; ++i) largest = std::fmax(largest, std::fabs(A[i]));
-  for (int j = 0; j < n; ++j) {
-    int p = j;
-    for (int i = j + 1; i < n; ++i)
-      if (std::fabs(A[i * n + j]) > std::fabs(A[p * n + j])) p = i;
-    pivot[j] = p;
-    if (!(std::fabs(A[p * n + j]) > 1e-14 * largest)) return false;
-    if (p != j) {
-      for (int k = 0; k < n; ++k) {
-        const double t = A[j * n + k];
-        A[j * n + k] = A[p * n + k];
-        A[p * n + k] = t;
-      }
-      const double t = b[j];
-      b[j] = b[p];
-      b[p] = t;
-    }
-    for (int i = j + 1; i < n; ++i) {
-      const double f = A[i * n + j] / A[j * n + j];
-      A[i * n + j] = f;
-      for (int k = j + 1; k < n; ++k) A[i * n + k] -= f * A[j * n + k];
-      b[i] -= f * b[j];
-    }
-  }
-  for (int i = n - 1; i >= 0; --i) {
-    double s = b[i];
-    for (int k = i + 1; k < n; ++k) s -= A[i * n + k] * b[k];
-    b[i] = s / A[i * n + i];
-  }
   return true;
 }
 

@@ -8,11 +8,11 @@
 
 namespace quiver::rt {
 
-void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales& scales, bool upper) {
+void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales& scales) {
   const int r = s.r;
   const double* K0 = s.model->restStiffness;
   for (int i = 0; i < r; ++i)
-    for (int j = upper ? i : 0; j < r; ++j)
+    for (int j = i; j < r; ++j)
       s.work.system[i * r + j] = scales.stiffness * s.work.stiffness[i * r + j] +
                                  scales.stateJacobian * stateJacobian[i * r + j] + scales.restStiffness * K0[i * r + j] +
                                  (i == j ? scales.identity : 0.0);
@@ -54,17 +54,14 @@ const double* evaluateForces(qv_instance& s, const double* q) {
   return s.loads.addStateForces(q, s.work.force);
 }
 
-QV_HOT qv_step_status solveNewton(qv_instance& s, const double* stateJacobian, double c1, double c2) {
+QV_HOT bool solveNewton(qv_instance& s, const double* stateJacobian, double c1, double c2) {
   const SystemScales scales = newtonSystem(s, c1, c2);
   if (const LaneFactor factor = takePresetFactor(s, scales); factor.A) {
     choleskySubstitute(factor, s.work.correction, s.r);
-    return QV_STEP_OK;
+    return true;
   }
-  fillSystem(s, stateJacobian, scales, true);
-  // The Cholesky attempt spoils the matrix, so the LU retry fills it again.
-  if (choleskySolve(s.work.system, s.work.correction, s.r)) return QV_STEP_OK;
-  fillSystem(s, stateJacobian, scales, false);
-  return luSolve(s.work.system, s.work.correction, s.work.pivot, s.r) ? QV_STEP_INDEFINITE : QV_STEP_RESET;
+  fillSystem(s, stateJacobian, scales);
+  return choleskySolve(s.work.system, s.work.correction, s.r);
 }
 
 } // namespace quiver::rt

@@ -31,17 +31,16 @@ inline SystemScales newtonSystem(const qv_instance& s, double c1, double c2) {
   return {std::fma(c1, s.config.rayleigh_beta, c2), c2, 0.0, std::fma(c1, s.config.rayleigh_alpha, 1.0)};
 }
 
-// The matrix into s.work.system: its upper triangle only when `upper` (all Cholesky reads), else
-// the whole.
-void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales& scales, bool upper);
+// The matrix's upper triangle (all Cholesky reads) into s.work.system.
+void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales& scales);
 
 // The group's Cholesky factor (step_many.h) of the matrix with these scales at the point just
 // evaluated, or none (A null); taken either way.
 LaneFactor takePresetFactor(qv_instance& s, const SystemScales& scales);
 
 // Solves the Newton system for the right-hand side in s.work.correction (the correction replaces
-// it): Cholesky, or pivoting LU (QV_STEP_INDEFINITE) when large compression has made the matrix
-// indefinite; QV_STEP_RESET when it is singular.
-qv_step_status solveNewton(qv_instance& s, const double* stateJacobian, double c1, double c2);
+// it) by Cholesky; false when large compression has made the matrix indefinite (the step is then
+// the minimiser's: integrator.h, minimizedInstead()).
+bool solveNewton(qv_instance& s, const double* stateJacobian, double c1, double c2);
 
 } // namespace quiver::rt

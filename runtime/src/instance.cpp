@@ -27,7 +27,7 @@ void defaultConfig(qv_instance_config& config, const qv_model* model) {
   config.integrator = QV_INTEGRATOR_IMPLICIT_NEWMARK;
   config.time_step = model ? model->info.time_step : 1.0 / 60.0;
   config.solver = QV_SOLVER_MINIMIZE;
-  config.newton_iterations = 8;
+  config.newton_iterations = quiver::rt::kMinimizerIterations;
   config.newton_tolerance = 1e-6;
   config.rayleigh_alpha = model ? model->info.rayleigh_alpha : 0.0;
   config.rayleigh_beta = model ? model->info.rayleigh_beta : 0.0;
@@ -115,7 +115,6 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
   work.segmentEnd = c.take<double>(r);
   work.midpointVelocity = c.take<double>(r);
   work.stateForceSink = c.take<double>(r);
-  work.pivot = c.take<int>(r);
   work.polynomialScratch = c.take<double>(quiver::rt::ReducedPolynomial::scratchSize(r));
   work.presetAt = c.take<double>(r);
   work.presetForce = c.take<double>(r);
@@ -138,12 +137,21 @@ void qv_instance::rest() {
   if (flying()) frame.goHome();
 }
 
-bool qv_instance::healthy() const {
-  // The minimising solver cannot run away on finite input, so only non-finite states reset it.
-  const bool bounded = config.solver == QV_SOLVER_MINIMIZE && config.integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES;
+bool qv_instance::withinBounds(const double* endQ, const double* endV, const double* endA) const {
   for (int i = 0; i < r; ++i)
-    if (!(bounded ? std::isfinite(q[i]) : std::fabs(q[i]) <= maxQ) || !std::isfinite(v[i]) || !std::isfinite(a[i]))
-      return false;
+    if (!(std::fabs(endQ[i]) <= maxQ) || !std::isfinite(endV[i]) || !std::isfinite(endA[i])) return false;
+  return true;
+}
+
+bool qv_instance::healthy() const {
+  // The implicit integrators' steps cannot run away on finite input (a fixed Newton step that
+  // would is taken by the minimiser instead), so only non-finite states reset them.
+  if (config.integrator == QV_INTEGRATOR_CENTRAL_DIFFERENCES) {
+    if (!withinBounds(q, v, a)) return false;
+  } else {
+    for (int i = 0; i < r; ++i)
+      if (!std::isfinite(q[i]) || !std::isfinite(v[i]) || !std::isfinite(a[i])) return false;
+  }
   return !flying() || frame.finite();
 }
 

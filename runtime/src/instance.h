@@ -42,7 +42,6 @@ struct StepBuffers {
   double* segmentEnd = nullptr;   // the far end of the segment the energy budget bisects
   double* midpointVelocity = nullptr;  // (v_start + v_end) / 2, for damping's share of the budget
   double* stateForceSink = nullptr;    // where stepEnergy() lets the state forces add the force it does not need
-  int* pivot = nullptr;           // LU's row exchanges
   double* polynomialScratch = nullptr;
   // A group stepped together (step_many.h) evaluates each member's polynomial at the point its
   // step will evaluate next: R(q) and E(q) here, K(q) in `stiffness`. The step's next elastic
@@ -76,7 +75,7 @@ struct qv_instance {
   bool ownsMemory;
   qv_instance_config config;
   int r;
-  double maxQ;  // |q|_inf beyond which the state counts as blown up (Newton solver, central differences)
+  double maxQ;  // |q|_inf past which a step has blown up (a fixed Newton step's end, central differences)
   double *q, *v, *a;
   double elasticEnergyAtState;  // E(q), kept by whatever changes q (the minimising solver's energy budget)
   double energySlack;           // energy the discretisation lost that a later step may win back
@@ -97,6 +96,8 @@ struct qv_instance {
   void carve(quiver::rt::BlockCarver& c);
   void rest();
   bool healthy() const;
+  // A step's end (q, v, a): finite, and |q| within maxQ.
+  bool withinBounds(const double* q, const double* v, const double* a) const;
   // One step of the configured integrator; per-step loads are spent; a blown-up state resets.
   qv_step_status step();
   void setState(const double* q, const double* v, const double* a);

@@ -79,7 +79,7 @@ QV_HOT void factoriseGroup(qv_instance* const* group, int count, const SystemSca
   choleskyFactorLanes(A, r, ok);
   for (int l = 0; l < count; ++l) {
     qv_instance& s = *group[l];
-    // Not positive definite: the solver's own factorisation decides (pivoting LU, or a shift).
+    // Not positive definite: the solver's own factorisation decides (the minimiser shifts it).
     s.work.presetFactor = ok[l] && factorisedInGroup(s) ? LaneFactor{A, r, l} : LaneFactor{};
     s.work.presetScales = lane[l];
   }

@@ -38,6 +38,15 @@ def test_defaults_are_the_documented_ones(model):
     assert np.all(s.q == 0) and np.all(s.velocity == 0) and s.energies() == (0, 0)
 
 
+def test_a_fixed_newton_step_that_would_blow_up_is_the_minimisers_and_says_so(model, tip):
+    s = quiver.Instance(model, solver="newton", newton_iterations=1, max_displacement=0.01)
+    s.add_vertex_force(tip, (0, 0, -1e9))
+    assert s.step() != quiver.StepStatus.RESET
+    assert s.last_step["minimized"] and np.all(np.isfinite(s.q)) and np.abs(s.q).max() > 0
+    s.step()
+    assert np.all(np.isfinite(s.q))
+
+
 def test_an_instance_keeps_its_model_alive(model_path):
     s = quiver.Instance(quiver.Model(model_path))
     s.set_gravity((0, 0, -quiver.STANDARD_GRAVITY))

@@ -2,6 +2,7 @@
 // projection, states against stepping one by one, jobs, and bad arguments.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -243,6 +244,7 @@ TEST(StepMany, NewtonMatricesFactorisedInGroupsAgreeWithEachInstanceOwn) {
     size_t bytes = 0;
     Scratch scratch = scratchFor(m.model, 1, bytes);
     std::vector<qv_step_status> statuses(count);
+    std::vector<bool> minimized(count, false);
     int indefinite = 0;
     for (int step = 0; step < steps; ++step) {
       batched.load(step);
@@ -251,16 +253,28 @@ TEST(StepMany, NewtonMatricesFactorisedInGroupsAgreeWithEachInstanceOwn) {
       for (int i = 0; i < count; ++i) {
         const qv_step_status alone = qv_instance_step(single.instances[i]);
         EXPECT_EQ(statuses[i], alone) << what << ", instance " << i << " step " << step;
+        EXPECT_NE(alone, QV_STEP_RESET) << what << ", instance " << i << " step " << step;
         indefinite += alone == QV_STEP_INDEFINITE;
+        qv_step_report a, b;
+        qv_instance_last_step(batched.instances[i], &a);
+        qv_instance_last_step(single.instances[i], &b);
+        minimized[i] = minimized[i] || a.minimized || b.minimized;
       }
     }
+    // A held tip and the longest time step drive two fixed Newton instances to steps the minimiser
+    // takes over (they used to reset), far from converging in its 8 iterations: from there on
+    // their motion is as sensitive to the rounding of the groups' sums as any chaotic motion, and
+    // they are left out of the bound (docs/architecture.md, "Many instances").
     double largest = 0, worst = 0;
     unsigned long long taken = 0;
+    int rescued = 0;
     for (int i = 0; i < count; ++i) {
       const std::vector<double> a = batched.state(i), b = single.state(i);
+      rescued += minimized[i];
       for (int k = 0; k < m.info.r; ++k) {
         largest = std::max(largest, std::abs(b[k]));
-        worst = std::max(worst, std::abs(a[k] - b[k]));
+        if (!minimized[i]) worst = std::max(worst, std::abs(a[k] - b[k]));
+        EXPECT_TRUE(std::isfinite(a[k]) && std::isfinite(b[k])) << what << ", instance " << i;
       }
       taken += batched.instances[i]->work.presetFactorsTaken;
       EXPECT_EQ(single.instances[i]->work.presetFactorsTaken, 0u) << what;
@@ -270,7 +284,9 @@ TEST(StepMany, NewtonMatricesFactorisedInGroupsAgreeWithEachInstanceOwn) {
     // Every step solves with the group's factor at least once, but where the matrix was not
     // positive definite (then its own solve decides).
     EXPECT_GE(taken, static_cast<unsigned long long>(steps * count - indefinite)) << what;
-    std::printf("%s: %d of %d steps indefinite, %llu group factors taken\n", what.c_str(), indefinite, steps * count, taken);
+    EXPECT_LE(rescued, 2) << what;
+    std::printf("%s: %d of %d steps indefinite, %llu group factors taken, %d instances with steps the minimiser took\n",
+                what.c_str(), indefinite, steps * count, taken, rescued);
   }
 }
 

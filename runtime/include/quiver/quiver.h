@@ -16,7 +16,7 @@ extern "C" {
 #endif
 
 #define QV_VERSION_MAJOR 0
-#define QV_VERSION_MINOR 7
+#define QV_VERSION_MINOR 8
 #define QV_VERSION_PATCH 0
 #define QV_VERSION_NUMBER (QV_VERSION_MAJOR * 10000 + QV_VERSION_MINOR * 100 + QV_VERSION_PATCH)
 
@@ -157,9 +157,13 @@ typedef enum qv_solver {
                              Rayleigh damping uses the rest stiffness, C = alpha I + beta K(0). Costs about 3x a
                              Newton step when one iteration converges (bench/README.md). */
   QV_SOLVER_NEWTON = 1,   /* Barbic & James 2005: exactly newton_iterations Newton iterations on the equations of
-                             motion, no line search, C = alpha I + beta K(q): the fastest. Safe for loads that keep
-                             the strains moderate at the model's time step; stiff springs, large twists, long time
-                             steps or sudden releases can diverge (then it resets to rest: QV_STEP_RESET). */
+                             motion, no line search, C = alpha I + beta K(q): the fastest while the strains stay
+                             moderate. Where they do not (stiff springs, large twists, long time steps, sudden loads
+                             and releases), compression makes the Newton system indefinite and the iterations can
+                             pump energy in: a step whose system is not positive definite, or whose end would move a
+                             vertex farther than max_displacement, is taken by the minimising solver instead (at
+                             most 8 iterations; qv_step_report.minimized), so it does not reset on finite input
+                             either. */
   QV_SOLVER_COUNT
 } qv_solver;
 
@@ -186,8 +190,9 @@ typedef struct qv_instance_config {
   double rayleigh_alpha;     /* 1/s, >= 0; default: the model's */
   double rayleigh_beta;      /* s, >= 0; default: the model's */
   int max_constraints;       /* penalty constraint slots (drag springs, pinned groups), 0..64; default 4 */
-  double max_displacement;   /* m; QV_SOLVER_NEWTON and central differences: a step that moves a vertex farther resets
-                                the instance; default 100 x the model's diagonal */
+  double max_displacement;   /* m; a step that would move a vertex farther: QV_SOLVER_NEWTON takes it with the minimising
+                                solver instead, central differences reset the instance; default 100 x the model's
+                                diagonal */
   qv_elasticity elasticity;  /* default QV_ELASTICITY_STVK */
   int free_flight;           /* 1: the object flies in a moving frame (qv_rigid_state; needs has_rigid_body); default 0 */
   int max_contacts;          /* in flight: contact points solved per step, 0..4096; default 64. When more touch, each
@@ -211,10 +216,10 @@ QV_API void qv_instance_destroy(qv_instance* instance);
 
 typedef enum qv_step_status {
   QV_STEP_OK = 0,
-  QV_STEP_INDEFINITE = 1, /* the system matrix was indefinite (large compression): shifted to positive definite
-                             (QV_SOLVER_MINIMIZE) or solved by pivoting LU (QV_SOLVER_NEWTON) */
-  QV_STEP_RESET = 2       /* the state became non-finite (any solver), exceeded max_displacement or the solve failed
-                             (QV_SOLVER_NEWTON, central differences): the instance was reset to rest */
+  QV_STEP_INDEFINITE = 1, /* the minimising solver (by choice, or taking a QV_SOLVER_NEWTON step) met a system matrix
+                             made indefinite by large compression, and shifted it to positive definite */
+  QV_STEP_RESET = 2       /* the state became non-finite (non-finite loads or state set), or central differences
+                             moved a vertex farther than max_displacement: the instance was reset to rest */
 } qv_step_status;
 
 /* Advances one time step under the loads set so far; per-step loads are then cleared. */
@@ -229,6 +234,9 @@ typedef struct qv_step_report {
   int held_back;           /* QV_SOLVER_MINIMIZE: 1 when the end position alone held more energy than the step may
                               end with, so it was drawn back toward the start (the velocity keeps what is left) */
   double energy_removed;   /* QV_SOLVER_MINIMIZE: kinetic energy (J) the step took out so as not to add energy */
+  int minimized;           /* QV_SOLVER_NEWTON: 1 when the minimising solver took the step (the Newton system was not
+                              positive definite, or the step would have moved a vertex past max_displacement); the
+                              fields above then describe its step */
 } qv_step_report;
 QV_API void qv_instance_last_step(const qv_instance* instance, qv_step_report* report);
 

@@ -1,6 +1,6 @@
 // Backward Euler: first order and numerically damped. The minimising solver
 // (incremental_potential.h) by default; QV_SOLVER_NEWTON: Newton on the end-of-step velocity,
-// starting from the current one.
+// starting from the current one (or the minimiser: minimizedInstead()).
 #include <cstring>
 
 #include "../dynamics.h"
@@ -36,24 +36,24 @@ qv_step_status stepBackwardEuler(qv_instance& s) {
   const int r = s.r;
   double *q = s.q, *v = s.v, *a = s.a;
   std::memcpy(s.end.v, v, sizeof(double) * r);
-  qv_step_status status = QV_STEP_OK;
   for (int it = 0; it < s.config.newton_iterations; ++it, ++s.lastStep.newton_iterations) {
     for (int i = 0; i < r; ++i) s.end.q[i] = q[i] + h * s.end.v[i];
     const double* J = evaluateForces(s, s.end.q);
     dampingForces(s, s.end.v, s.work.damping);
     for (int i = 0; i < r; ++i)
       s.work.correction[i] = -((s.end.v[i] - v[i]) + h * (s.work.damping[i] + s.work.force[i] - s.loads.external(i)));
-    const qv_step_status solved = solveNewton(s, J, h, h * h);
-    if (solved == QV_STEP_RESET) return solved;
-    if (solved == QV_STEP_INDEFINITE) status = solved;
+    if (!solveNewton(s, J, h, h * h)) return minimizedInstead(s, minimizing);
     for (int i = 0; i < r; ++i) s.end.v[i] += s.work.correction[i];
   }
   for (int i = 0; i < r; ++i) {
-    a[i] = (s.end.v[i] - v[i]) / h;
-    v[i] = s.end.v[i];
-    q[i] += h * v[i];
+    s.end.a[i] = (s.end.v[i] - v[i]) / h;
+    s.end.q[i] = q[i] + h * s.end.v[i];
   }
-  return status;
+  if (!s.withinBounds(s.end.q, s.end.v, s.end.a)) return minimizedInstead(s, minimizing);
+  std::memcpy(q, s.end.q, sizeof(double) * r);
+  std::memcpy(v, s.end.v, sizeof(double) * r);
+  std::memcpy(a, s.end.a, sizeof(double) * r);
+  return QV_STEP_OK;
 }
 
 } // namespace quiver::rt

@@ -1,6 +1,6 @@
 // Implicit Newmark, beta = 1/4, gamma = 1/2 (the trapezoidal rule; Barbic & James 2005). The
 // minimising solver (incremental_potential.h) by default; QV_SOLVER_NEWTON: Newton on the
-// end-of-step acceleration, starting from the last one.
+// end-of-step acceleration, starting from the last one (or the minimiser: minimizedInstead()).
 #include <cstring>
 
 #include "../dynamics.h"
@@ -30,16 +30,21 @@ qv_step_status endNewmarkMinimization(qv_instance& s, const StepPredictor& p, qv
   return status;
 }
 
+namespace {
+
+qv_step_status minimizing(qv_instance& s) {
+  const StepPredictor p = beginNewmarkMinimization(s);
+  return endNewmarkMinimization(s, p, minimizeStep(s, p));
+}
+
+} // namespace
+
 qv_step_status stepImplicitNewmark(qv_instance& s) {
-  if (s.config.solver == QV_SOLVER_MINIMIZE) {
-    const StepPredictor p = beginNewmarkMinimization(s);
-    return endNewmarkMinimization(s, p, minimizeStep(s, p));
-  }
+  if (s.config.solver == QV_SOLVER_MINIMIZE) return minimizing(s);
   const double h = s.config.time_step, beta = kNewmarkBeta, gamma = kNewmarkGamma;
   const int r = s.r;
   double *q = s.q, *v = s.v, *a = s.a;
   std::memcpy(s.end.a, a, sizeof(double) * r);
-  qv_step_status status = QV_STEP_OK;
   for (int it = 0; it < s.config.newton_iterations; ++it, ++s.lastStep.newton_iterations) {
     for (int i = 0; i < r; ++i) {
       s.end.q[i] = it == 0 ? newmarkGuess(s, i) : q[i] + h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * s.end.a[i]);
@@ -51,17 +56,18 @@ qv_step_status stepImplicitNewmark(qv_instance& s) {
       s.work.correction[i] = -(s.end.a[i] + s.work.damping[i] + s.work.force[i] - s.loads.external(i));
     double c1, c2;
     newmarkNewtonScales(s, c1, c2);
-    const qv_step_status solved = solveNewton(s, J, c1, c2);
-    if (solved == QV_STEP_RESET) return solved;
-    if (solved == QV_STEP_INDEFINITE) status = solved;
+    if (!solveNewton(s, J, c1, c2)) return minimizedInstead(s, minimizing);
     for (int i = 0; i < r; ++i) s.end.a[i] += s.work.correction[i];
   }
   for (int i = 0; i < r; ++i) {
-    q[i] += h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * s.end.a[i]);
-    v[i] += h * ((1 - gamma) * a[i] + gamma * s.end.a[i]);
-    a[i] = s.end.a[i];
+    s.end.q[i] = q[i] + (h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * s.end.a[i]));
+    s.end.v[i] = v[i] + h * ((1 - gamma) * a[i] + gamma * s.end.a[i]);
   }
-  return status;
+  if (!s.withinBounds(s.end.q, s.end.v, s.end.a)) return minimizedInstead(s, minimizing);
+  std::memcpy(q, s.end.q, sizeof(double) * r);
+  std::memcpy(v, s.end.v, sizeof(double) * r);
+  std::memcpy(a, s.end.a, sizeof(double) * r);
+  return QV_STEP_OK;
 }
 
 } // namespace quiver::rt

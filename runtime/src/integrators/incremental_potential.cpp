@@ -68,7 +68,7 @@ public:
     double mu = 0;
     for (int attempt = 0; attempt < 40; ++attempt) {
       scales.identity = diagonal + mu;
-      fillSystem(s_, jacobian, scales, true);
+      fillSystem(s_, jacobian, scales);
       if (choleskySolve(s_.work.system, s_.work.correction, r_)) return mu > 0;
       mu = mu > 0 ? 4 * mu : 1e-6 * (largest + diagonal);
     }
@@ -205,7 +205,7 @@ void MinimizeTask::iterate() {
     report.converged = 1;
     return finish();
   }
-  if (iteration_ == s.config.newton_iterations) return finish();
+  if (iteration_ == maxIterations(s)) return finish();
   bool failed = false;
   if (Minimizer(s, p_).direction(at_.jacobian, failed)) status_ = QV_STEP_INDEFINITE;
   if (failed) return finish();

@@ -34,6 +34,14 @@ inline SystemScales minimizerSystem(const qv_instance& s, const StepPredictor& p
   return {1.0, 1.0, p.s * s.config.rayleigh_beta, std::fma(p.s, s.config.rayleigh_alpha, p.w)};
 }
 
+// The most Newton iterations of a minimising step: newton_iterations (by default
+// kMinimizerIterations), or kMinimizerIterations for a QV_SOLVER_NEWTON step it took over
+// (integrator.h, minimizedInstead()), where newton_iterations counts fixed iterations.
+constexpr int kMinimizerIterations = 8;
+inline int maxIterations(const qv_instance& s) {
+  return s.config.solver == QV_SOLVER_MINIMIZE ? s.config.newton_iterations : kMinimizerIterations;
+}
+
 // Phi at one iterate, the force scale of its convergence test and the state forces' Jacobian.
 struct PhiPoint {
   double phi = 0, scale = 0;

@@ -45,6 +45,18 @@ inline void newmarkNewtonScales(const qv_instance& s, double& c1, double& c2) {
   c1 = kNewmarkGamma * h;
   c2 = kNewmarkBeta * h * h;
 }
+// QV_SOLVER_NEWTON's way out, for both implicit integrators: a fixed Newton step whose system
+// large compression made indefinite, or whose end would move a vertex past max_displacement or is
+// not finite, is taken from the same start by the integrator's minimising step instead. Newton
+// iterations on indefinite systems pump energy into a soft object (under a push flipping near its
+// resonance, the bench's bar swung nine times as far as the minimiser lets it, and now and then
+// one iteration threw it past max_displacement, where it used to reset); the minimiser cannot
+// add energy.
+inline qv_step_status minimizedInstead(qv_instance& s, StepFunction minimizing) {
+  s.lastStep = qv_step_report{};
+  s.lastStep.minimized = 1;
+  return minimizing(s);
+}
 qv_step_status stepBackwardEuler(qv_instance& s);
 qv_step_status stepCentralDifferences(qv_instance& s);
 
