@@ -167,10 +167,10 @@ int renderModel(const std::string& path, const RenderOptions& o) {
     const ScenarioResult result = runScenario(target, model.mesh(), o.scenario, [&](int step) {
       if (frames.animated() ? step % o.every == 0 : step == o.scenario.steps) draw();
     });
-    // The runtime resets a diverged state to rest; say so rather than show a rest shape as "loaded".
+    // The runtime resets a non-finite state to rest; say so rather than show a rest shape as "loaded".
     if (result.failedSteps > 0)
-      std::fprintf(stderr, "quiver render: warning: the scenario diverged and the model was reset to rest %d times; "
-                           "try a smaller load or --solver minimize\n", result.failedSteps);
+      std::fprintf(stderr, "quiver render: warning: the scenario went non-finite and the model was reset to rest %d "
+                           "times\n", result.failedSteps);
   }
   frames.finish();
   return 0;

@@ -55,8 +55,9 @@ PolygonMesh readOff(std::string_view bytes, const std::string& name) {
     line.erase(line.begin());
     if (line.empty()) line = nextLine(in, "the counts");
     if (dimension) {
-      dims = static_cast<int>(whole(in, line[0], "the dimension"));
-      if (dims < 1 || dims > 3) in.fail("a dimension of " + std::to_string(dims) + "; 1, 2 or 3 are read here");
+      const int64_t n = whole(in, line[0], "the dimension");
+      if (n < 1 || n > 3) in.fail("a dimension of " + std::to_string(n) + "; 1, 2 or 3 are read here");
+      dims = static_cast<int>(n);
       line.erase(line.begin());
       if (line.empty()) line = nextLine(in, "the counts");
     }

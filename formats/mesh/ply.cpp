@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string_view>
+#include <unordered_set>
 #include <vector>
 
 #include "common/mesh_error.h"
@@ -57,7 +58,6 @@ struct Element {
   std::string name;
   int64_t count = 0;
   std::vector<Property> properties;
-  int line = 0;
 };
 
 enum class Format { Ascii, LittleEndian, BigEndian };
@@ -72,6 +72,7 @@ Header readHeader(TextCursor& in) {
   if (in.restOfLine() != "ply") in.fail("not a PLY file: it must begin with the line 'ply'");
   Header h;
   bool formatSeen = false;
+  std::unordered_set<std::string> names;
   for (;;) {
     if (in.position() >= in.text().size()) in.fail("the header has no end_header line");
     const std::string_view line = in.restOfLine();
@@ -89,9 +90,8 @@ Header readHeader(TextCursor& in) {
       int64_t count = -1;
       if (w.size() != 3 || !parseInteger(w[2], count) || count < 0 || count > INT32_MAX)
         in.fail("expected 'element NAME COUNT' with a count from 0 to " + std::to_string(INT32_MAX));
-      for (const Element& e : h.elements)
-        if (e.name == w[1]) in.fail("element '" + printableToken(w[1]) + "' is defined twice");
-      h.elements.push_back({std::string(w[1]), count, {}, in.line()});
+      if (!names.insert(std::string(w[1])).second) in.fail("element '" + printableToken(w[1]) + "' is defined twice");
+      h.elements.push_back({std::string(w[1]), count, {}});
     } else if (w[0] == "property") {
       if (h.elements.empty()) in.fail("a property before any element");
       Property p;

@@ -77,7 +77,7 @@ struct qv_instance {
   int r;
   double maxQ;  // |q|_inf past which a step has blown up (a fixed Newton step's end, central differences)
   double *q, *v, *a;
-  double elasticEnergyAtState;  // E(q), kept by whatever changes q (the minimising solver's energy budget)
+  double elasticEnergyAtState;  // E(q) for the minimising solver's energy budget (fixed Newton steps leave it stale)
   double energySlack;           // energy the discretisation lost that a later step may win back
   qv_step_report lastStep;
   quiver::rt::Loads loads;

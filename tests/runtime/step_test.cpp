@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "runtime/src/instance.h"
 #include "tests/runtime/runtime_fixture.h"
 
 using namespace quiver;
@@ -182,6 +183,39 @@ TEST(Step, AFixedNewtonStepThatWouldBlowUpIsTakenByTheMinimiserAndSaysSo) {
     // Then, without the shove, fixed Newton steps again.
     EXPECT_NE(qv_instance_step(inst.s), QV_STEP_RESET);
     EXPECT_TRUE(state(inst.s, r).allFinite());
+
+    // From a state fixed Newton steps bent under gravity, the minimiser budgets from that state's
+    // energy: let go (no load: the budget binds), its step equals the minimiser's from the same
+    // state set by hand. maxQ = 0 makes the fixed Newton step hand the step over.
+    qv_instance_config defaults;
+    qv_instance_config_init(&defaults, m.model);
+    config.max_displacement = defaults.max_displacement;
+    Instance bent(m.model, config), same(m.model, alone);
+    const double g[3] = {0, 0, -QV_STANDARD_GRAVITY};
+    qv_instance_set_gravity(bent.s, g);
+    qv_instance_set_gravity(same.s, g);
+    for (int step = 0; step < 20; ++step) {
+      ASSERT_NE(qv_instance_step(bent.s), QV_STEP_RESET);
+      qv_instance_last_step(bent.s, &report);
+      ASSERT_EQ(report.minimized, 0) << "step " << step;
+    }
+    Eigen::VectorXd q(r), v(r), a(r);
+    qv_instance_get_state(bent.s, q.data(), v.data(), a.data());
+    ASSERT_GT(q.norm(), 0.0);
+    qv_instance_set_state(same.s, q.data(), v.data(), a.data());
+    const double none[3] = {0, 0, 0};
+    qv_instance_set_gravity(bent.s, none);
+    qv_instance_set_gravity(same.s, none);
+    bent.s->maxQ = 0;
+    EXPECT_NE(qv_instance_step(bent.s), QV_STEP_RESET);
+    qv_instance_step(same.s);
+    qv_instance_last_step(bent.s, &report);
+    EXPECT_EQ(report.minimized, 1) << qv_integrator_name(integrator);
+    Eigen::VectorXd q2(r), v2(r);
+    qv_instance_get_state(bent.s, q.data(), v.data(), nullptr);
+    qv_instance_get_state(same.s, q2.data(), v2.data(), nullptr);
+    EXPECT_EQ(q, q2) << qv_integrator_name(integrator);
+    EXPECT_EQ(v, v2) << qv_integrator_name(integrator);
   }
 }
 

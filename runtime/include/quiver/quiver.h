@@ -185,14 +185,14 @@ typedef struct qv_instance_config {
   double time_step;          /* s, > 0; default: the model's suggested step */
   qv_solver solver;          /* implicit integrators; default QV_SOLVER_MINIMIZE */
   int newton_iterations;     /* >= 1: the most Newton iterations (QV_SOLVER_MINIMIZE, default 8), or exactly this many
-                                (QV_SOLVER_NEWTON; Barbic & James use 1) */
+                                (QV_SOLVER_NEWTON; Barbic & James use 1; a step the minimiser takes over: at most 8) */
   double newton_tolerance;   /* QV_SOLVER_MINIMIZE stops once |gradient| <= this x the step's force scale; default 1e-6 */
   double rayleigh_alpha;     /* 1/s, >= 0; default: the model's */
   double rayleigh_beta;      /* s, >= 0; default: the model's */
   int max_constraints;       /* penalty constraint slots (drag springs, pinned groups), 0..64; default 4 */
   double max_displacement;   /* m; a step that would move a vertex farther: QV_SOLVER_NEWTON takes it with the minimising
-                                solver instead, central differences reset the instance; default 100 x the model's
-                                diagonal */
+                                solver instead (so every step, at about 3x the cost, while a load holds the object
+                                past it), central differences reset the instance; default 100 x the model's diagonal */
   qv_elasticity elasticity;  /* default QV_ELASTICITY_STVK */
   int free_flight;           /* 1: the object flies in a moving frame (qv_rigid_state; needs has_rigid_body); default 0 */
   int max_contacts;          /* in flight: contact points solved per step, 0..4096; default 64. When more touch, each

@@ -1,6 +1,7 @@
 #pragma once
 // Time integrators. Each lives in its own file as one function that advances an instance by one
 // step; adding one means its file, a value of qv_integrator and a row of kIntegrators.
+#include "../elasticity.h"
 #include "../instance.h"
 #include "incremental_potential.h"
 
@@ -55,6 +56,10 @@ inline void newmarkNewtonScales(const qv_instance& s, double& c1, double& c2) {
 inline qv_step_status minimizedInstead(qv_instance& s, StepFunction minimizing) {
   s.lastStep = qv_step_report{};
   s.lastStep.minimized = 1;
+  // Its energy budget starts from this state, as after qv_instance_set_state: fixed Newton steps
+  // keep no account of E(q).
+  s.elasticEnergyAtState = elasticEnergy(*s.model, s.config.elasticity, s.q, s.work.polynomialScratch);
+  s.energySlack = 0;
   return minimizing(s);
 }
 qv_step_status stepBackwardEuler(qv_instance& s);

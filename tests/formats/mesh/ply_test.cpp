@@ -16,7 +16,7 @@
 #include "common/surface_check.h"
 #include "formats/mesh/read_mesh.h"
 #include "formats/mesh/read_surface.h"
-#include "tests/formats/mesh/assimp_reference.h"
+#include "tests/formats/mesh/surface_test_support.h"
 
 namespace quiver {
 namespace {
@@ -133,16 +133,8 @@ TEST(PlyReader, AssimpsTestModelsReadAsAssimpsOwnImporterReadsThem) {
   EXPECT_GE(compared, 5);  // pond.0.ply, a truncated point cloud, neither reads
 }
 
-// Each malformed file is refused; the message starts with the file's name and says `expected`.
 void expectRefused(const std::string& bytes, const std::string& expected) {
-  try {
-    read(bytes, "bad.ply");
-    ADD_FAILURE() << "read: " << expected;
-  } catch (const MeshError& e) {
-    const std::string message = e.what();
-    EXPECT_EQ(message.rfind("bad.ply", 0), 0u) << message;
-    EXPECT_NE(message.find(expected), std::string::npos) << message;
-  }
+  test::expectSurfaceRefused(bytes, "ply", "bad.ply", expected);
 }
 
 TEST(PlyReader, MalformedFilesAreRefusedNamingTheLineOrByte) {

@@ -1,5 +1,5 @@
 #pragma once
-// Our readers of formats Assimp also reads (own_readers.h) against Assimp's own importer.
+// Checks shared by the tests of our surface readers (own_readers.h).
 #include <gtest/gtest.h>
 
 #include <assimp/Importer.hpp>
@@ -48,6 +48,20 @@ inline bool expectReadsAsAssimpsOwnImporter(const std::string& path) {
                                  << positions[p];
   EXPECT_EQ(t, triangles.size()) << path << ": the first triangle index that differs";
   return true;
+}
+
+// readSurfaceMemory() refuses `bytes` in `format`: the message starts with `name` and says
+// `expected`.
+inline void expectSurfaceRefused(const std::string& bytes, const char* format, const std::string& name,
+                                 const std::string& expected) {
+  try {
+    readSurfaceMemory(bytes.data(), bytes.size(), format, name);
+    ADD_FAILURE() << "read: " << expected;
+  } catch (const MeshError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind(name, 0), 0u) << message;
+    EXPECT_NE(message.find(expected), std::string::npos) << message;
+  }
 }
 
 } // namespace quiver::test
