@@ -126,9 +126,9 @@ void Evaluate(benchmark::State& state, const char* path, bool withStiffness, int
 
 // Gravity, plus a tenth of its pull on the first coordinate flipping every quarter second, so that
 // every step has work to do (a settled object converges at once and would flatter the minimiser),
-// within the strains the fixed Newton step is made for: twice the pull, flipping every half second,
-// bent the soft bar so far that its Newton systems were indefinite in 9 steps of 10 at r = 30, and
-// the minimiser now takes those (`minimized`, the share of fixed Newton steps it took).
+// within the strains the fixed Newton step is made for: under twice the pull, flipping every half
+// second, the fixed Newton steps swung the soft r = 30 bar nine times as far as the minimiser's,
+// and the minimiser took 41% of them over (`minimized`, the share of fixed Newton steps it took).
 void Step(benchmark::State& state, const char* path, qv_solver solver, int precision) {
   Loaded m(path, precision);
   qv_instance_config config;

@@ -159,11 +159,10 @@ typedef enum qv_solver {
   QV_SOLVER_NEWTON = 1,   /* Barbic & James 2005: exactly newton_iterations Newton iterations on the equations of
                              motion, no line search, C = alpha I + beta K(q): the fastest while the strains stay
                              moderate. Where they do not (stiff springs, large twists, long time steps, sudden loads
-                             and releases), compression makes the Newton system indefinite and the iterations can
-                             pump energy in: a step whose system is not positive definite, or whose end would move a
-                             vertex farther than max_displacement, is taken by the minimising solver instead (at
-                             most 8 iterations; qv_step_report.minimized), so it does not reset on finite input
-                             either. */
+                             and releases), the iterations add energy and can diverge: a step whose system is not
+                             positive definite, or whose end would move a vertex farther than max_displacement, is
+                             taken by the minimising solver instead (at most 8 iterations; qv_step_report.minimized),
+                             so it does not reset on finite input either; the energy the fixed steps add stays. */
   QV_SOLVER_COUNT
 } qv_solver;
 
