@@ -1,9 +1,11 @@
+#include "formats/mesh/own_readers.h"
+
+#include <cmath>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "common/mesh_error.h"
-#include "formats/mesh/own_readers.h"
 #include "formats/mesh/text_cursor.h"
 
 namespace quiver {
@@ -13,7 +15,7 @@ namespace {
 // The next line that holds anything but a comment, as words.
 std::vector<std::string_view> nextLine(TextCursor& in, const char* what) {
   for (;;) {
-    if (in.atEnd()) in.fail(std::string("unexpected end of file while reading ") + what);
+    if (in.atEnd()) in.token(what);  // fails, naming the file's end
     std::vector<std::string_view> w = words(in.restOfLine());
     if (!w.empty()) return w;
   }
@@ -75,11 +77,15 @@ PolygonMesh readOff(std::string_view bytes, const std::string& name) {
     double x[3] = {0, 0, 0};
     for (int c = 0; c < dims; ++c) x[c] = number(in, line[c], "a coordinate");
     const double w = homogeneous ? number(in, line[dims], "the homogeneous coordinate") : 1.0;
-    for (double c : x) out.positions.push_back(static_cast<float>(c / w));
+    for (double c : x) {
+      const float position = toFloat(c / w);
+      if (!std::isfinite(position)) in.fail("vertex " + std::to_string(v) + ": a coordinate is not a finite float");
+      out.positions.push_back(position);
+    }
     if (normals)
-      for (int c = 0; c < 3; ++c) out.normals.push_back(static_cast<float>(number(in, line[dims + homogeneous + c], "a normal")));
+      for (int c = 0; c < 3; ++c) out.normals.push_back(toFloat(number(in, line[dims + homogeneous + c], "a normal")));
     if (uv)  // after the colours: the line's last two numbers
-      for (int c = 0; c < 2; ++c) out.uvs.push_back(static_cast<float>(number(in, line[line.size() - 2 + c], "a texture coordinate")));
+      for (int c = 0; c < 2; ++c) out.uvs.push_back(toFloat(number(in, line[line.size() - 2 + c], "a texture coordinate")));
   }
   for (int64_t f = 0; f < faceCount; ++f) {
     line = nextLine(in, "a face");

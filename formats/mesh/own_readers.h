@@ -7,6 +7,7 @@
 // on (60 bytes asked for more than 2 GB). Ours bound every count by the bytes left and name the
 // line or byte of any problem; the scene they make goes through the same post-processing as every
 // other format.
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -23,6 +24,14 @@ struct PolygonMesh {
   std::vector<float> positions, normals, uvs;
   std::vector<unsigned> faceSizes, indices;
 };
+
+// A value read as a float: infinite beyond float's range (where a plain conversion is undefined).
+inline float toFloat(double v) {
+  constexpr double kMax = std::numeric_limits<float>::max();
+  if (v > kMax) return std::numeric_limits<float>::infinity();
+  if (v < -kMax) return -std::numeric_limits<float>::infinity();
+  return static_cast<float>(v);  // NaN stays NaN
+}
 
 // ASCII and binary (both byte orders) PLY: the vertex element's x, y, z (nx, ny, nz; s, t or u, v),
 // the face element's vertex_indices (or vertex_index) lists; other elements and properties are

@@ -141,21 +141,23 @@ public:
   // A list's length, bounded by what the bytes left could hold of its items (at least one byte each
   // in ASCII, the type's size in binary), so that no count can run a loop past the file's end.
   int64_t length(const Property& p) {
-    const size_t at = ascii_ ? text_.position() : binary_.position();
+    const size_t at = position();
     const double n = value(p.countType, p.name.c_str());
     const double room = ascii_ ? double(text_.text().size() - text_.position()) : double(binary_.remaining() / sizeOf(p.type));
     if (n < 0 || n > room || n > INT32_MAX) {
       const std::string message = "the list " + p.name + " counts " + integerText(n) +
                                   " items, more than the bytes left in the file can hold";
-      if (ascii_) text_.fail(message);
-      binary_.failAt(at, message);
+      failAt(at, message);
     }
     return static_cast<int64_t>(n);
   }
 
-  [[noreturn]] void fail(const std::string& message) const {
+  // Where the next value starts (a byte offset), for failAt(): in ASCII the line of the value read
+  // last names the place.
+  size_t position() const { return ascii_ ? text_.position() : binary_.position(); }
+  [[noreturn]] void failAt(size_t at, const std::string& message) const {
     if (ascii_) text_.fail(message);
-    binary_.fail(message);
+    binary_.failAt(at, message);
   }
 
 private:
@@ -183,6 +185,10 @@ PolygonMesh readPly(std::string_view bytes, const std::string& name) {
   if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0) headerText.fail("the vertex element lacks one of the properties x, y, z");
   const int normal[3] = {indexOf(*vertices, "nx"), indexOf(*vertices, "ny"), indexOf(*vertices, "nz")};
   const bool hasNormals = normal[0] >= 0 && normal[1] >= 0 && normal[2] >= 0;
+  for (const Element& e : h.elements)
+    for (const Property& p : e.properties)
+      if (e.name == "face" && p.list && (p.name == "vertex_indices" || p.name == "vertex_index") && !integral(p.type))
+        headerText.fail("the face element's " + p.name + " list must have an integer type");
   int uv[2] = {-1, -1};
   for (const auto& [u, v] : {std::pair{"s", "t"}, {"u", "v"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}})
     if (uv[0] < 0 && indexOf(*vertices, u) >= 0 && indexOf(*vertices, v) >= 0) uv[0] = indexOf(*vertices, u), uv[1] = indexOf(*vertices, v);
@@ -194,6 +200,7 @@ PolygonMesh readPly(std::string_view bytes, const std::string& name) {
     if (e.properties.empty()) continue;  // its instances hold no bytes
     const bool isVertex = &e == vertices, isFace = e.name == "face";
     for (int64_t i = 0; i < e.count; ++i) {
+      const size_t start = body.position();
       values.assign(e.properties.size(), 0.0);
       for (size_t p = 0; p < e.properties.size(); ++p) {
         const Property& prop = e.properties[p];
@@ -203,23 +210,28 @@ PolygonMesh readPly(std::string_view bytes, const std::string& name) {
         }
         const int64_t n = body.length(prop);
         const bool indices = isFace && (prop.name == "vertex_indices" || prop.name == "vertex_index");
-        if (indices && !integral(prop.type)) body.fail("face lists of vertex indices must have an integer type");
         if (indices) out.faceSizes.push_back(static_cast<unsigned>(n));
         for (int64_t k = 0; k < n; ++k) {
+          const size_t at = body.position();
           const double index = body.value(prop.type, prop.name.c_str());
           if (!indices) continue;
           if (index < 0 || index >= double(vertices->count))
-            body.fail("face " + std::to_string(i) + ": vertex index " + integerText(index) + " is out of range [0, " +
-                      std::to_string(vertices->count) + ")");
+            body.failAt(at, "face " + std::to_string(i) + ": vertex index " + integerText(index) + " is out of range [0, " +
+                            std::to_string(vertices->count) + ")");
           out.indices.push_back(static_cast<unsigned>(index));
         }
       }
       if (!isVertex) continue;
-      for (int c = 0; c < 3; ++c) out.positions.push_back(static_cast<float>(values[xyz[c]]));
+      for (int c = 0; c < 3; ++c) {
+        const float x = toFloat(values[xyz[c]]);
+        if (!std::isfinite(x))
+          body.failAt(start, "vertex " + std::to_string(i) + ": coordinate " + formatReal(values[xyz[c]]) + " is not a finite float");
+        out.positions.push_back(x);
+      }
       if (hasNormals)
-        for (int c = 0; c < 3; ++c) out.normals.push_back(static_cast<float>(values[normal[c]]));
+        for (int c = 0; c < 3; ++c) out.normals.push_back(toFloat(values[normal[c]]));
       if (uv[0] >= 0)
-        for (int c = 0; c < 2; ++c) out.uvs.push_back(static_cast<float>(values[uv[c]]));
+        for (int c = 0; c < 2; ++c) out.uvs.push_back(toFloat(values[uv[c]]));
     }
   }
   return out;

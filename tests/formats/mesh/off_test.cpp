@@ -101,6 +101,10 @@ TEST(OffReader, MalformedFilesAreRefusedNamingTheLine) {
   std::string notANumber = cube("OFF\n8 6 12");
   notANumber.replace(notANumber.find("1 0 0"), 5, "1 zero 0");
   expectRefused(notANumber, "bad.off:4: expected a number for a coordinate, found 'zero'");
+  std::string tooLarge = cube("OFF\n8 6 12");
+  tooLarge.replace(tooLarge.find("1 0 0"), 5, "1e39 0 0");
+  expectRefused(tooLarge, "bad.off:4: vertex 1: a coordinate is not a finite float");
+  expectRefused("4OFF\n3 1 0\n0 0 0 0\n1 0 0 1\n0 1 0 1\n3 0 1 2\n", "bad.off:3: vertex 0: a coordinate is not a finite float");
 }
 
 } // namespace

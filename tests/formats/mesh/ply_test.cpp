@@ -174,6 +174,15 @@ TEST(PlyReader, MalformedFilesAreRefusedNamingTheLineOrByte) {
   std::string floatCount = ascii;
   floatCount.replace(floatCount.find("list uchar int"), 14, "list float int");
   expectRefused(floatCount, "(a list's count type integral)");
+  std::string floatIndices = ascii;
+  floatIndices.replace(floatIndices.find("list uchar int"), 14, "list uchar float");
+  expectRefused(floatIndices, ":17: the face element's vertex_indices list must have an integer type");
+  std::string binaryOutOfRange = good;  // named at the index's own first byte
+  binaryOutOfRange[firstFace + 1 + 4 * 3] = 8;
+  expectRefused(binaryOutOfRange, "byte " + std::to_string(firstFace + 1 + 4 * 3) + ": face 0: vertex index 8 is out of range");
+  std::string tooLarge = ascii;
+  tooLarge.replace(tooLarge.find("0 0 0 200"), 9, "1e39 0 0 200");
+  expectRefused(tooLarge, ":18: vertex 0: coordinate 1e+39 is not a finite float");
   expectRefused("ply\nformat ascii 1.0\nproperty float x\nend_header\n", ":3: a property before any element");
   expectRefused("ply\nformat ascii 1.0\nelement vertex 3000000000\nproperty float x\nend_header\n", ":3: expected 'element NAME COUNT'");
   // Counts a file cannot hold allocate nothing: reading stops at the file's end.
