@@ -312,7 +312,8 @@ colliders persist. Positions and normals are in the world (in flight, carried by
            },
            py::arg("count") = 1, R"(Advances `count` time steps (each under the loads set so far; per-step loads are
 cleared after the first). Returns a StepStatus: OK, INDEFINITE (the minimiser shifted an indefinite system)
-or RESET (the state became non-finite and was reset to rest), the worst of the steps taken.)")
+or RESET (the state became non-finite, or central differences ran past max_displacement, and was reset to
+rest), the worst of the steps taken; last_step describes the last.)")
       .def_property_readonly("last_step", [](const Instance& self) {
         qv_step_report r;
         qv_instance_last_step(self.use(), &r);

@@ -333,7 +333,7 @@ private:
     ImGui::Text("%.0f steps/s; a step costs %.1f us (%.0f/s possible)", stepsPerSecond_, session_.stepMicros(),
                 session_.stepMicros() > 0 ? 1e6 / session_.stepMicros() : 0.0);
     if (session_.behindRealTime()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "slower than real time");
-    if (session_.resets()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%d resets (diverged, back to rest)", session_.resets());
+    if (session_.resets()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%d resets (non-finite, back to rest)", session_.resets());
     ImGui::Text("energy: kinetic %.3g J, elastic %.3g J", energies_.kinetic, energies_.elastic);
     const int shown = static_cast<int>(std::min<size_t>(energyFrames_, totalEnergy_.size()));  // a ring, oldest first
     ImGui::PlotLines("kinetic + elastic", totalEnergy_.data(), shown, static_cast<int>(energyFrames_ % totalEnergy_.size()), nullptr, 0,

@@ -34,8 +34,8 @@ inline float toFloat(double v) {
 }
 
 // ASCII and binary (both byte orders) PLY: the vertex element's x, y, z (nx, ny, nz; s, t or u, v),
-// the face element's vertex_indices (or vertex_index) lists; other elements and properties are
-// skipped by their sizes.
+// the face element's vertex_indices (or vertex_index) lists and the tristrips element's strips
+// (-1 starts the next); other elements and properties are skipped by their sizes.
 PolygonMesh readPly(std::string_view bytes, const std::string& name);
 
 // OFF with the optional prefixes of its header keyword (ST, C, N, 4, n: texture coordinates,

@@ -144,11 +144,9 @@ public:
     const size_t at = position();
     const double n = value(p.countType, p.name.c_str());
     const double room = ascii_ ? double(text_.text().size() - text_.position()) : double(binary_.remaining() / sizeOf(p.type));
-    if (n < 0 || n > room || n > INT32_MAX) {
-      const std::string message = "the list " + p.name + " counts " + integerText(n) +
-                                  " items, more than the bytes left in the file can hold";
-      failAt(at, message);
-    }
+    if (n < 0) failAt(at, "the list " + p.name + " counts " + integerText(n) + " items");
+    if (n > room || n > INT32_MAX)
+      failAt(at, "the list " + p.name + " counts " + integerText(n) + " items, more than the bytes left in the file can hold");
     return static_cast<int64_t>(n);
   }
 
@@ -165,6 +163,23 @@ private:
   TextCursor text_;
   ByteCursor binary_;
 };
+
+bool isIndexList(const Element& e, const Property& p) {
+  return (e.name == "face" || e.name == "tristrips") && p.list && (p.name == "vertex_indices" || p.name == "vertex_index");
+}
+
+// A triangle strip's triangles, every other one turned so that all wind alike; degenerate ones
+// (a repeated vertex, as strips use to join) dropped.
+void addStrip(const std::vector<unsigned>& strip, PolygonMesh& out) {
+  for (size_t k = 0; k + 2 < strip.size(); ++k) {
+    unsigned a = strip[k], b = strip[k + 1];
+    const unsigned c = strip[k + 2];
+    if (k % 2) std::swap(a, b);
+    if (a == b || b == c || a == c) continue;
+    out.faceSizes.push_back(3);
+    out.indices.insert(out.indices.end(), {a, b, c});
+  }
+}
 
 int indexOf(const Element& e, std::string_view name) {
   for (size_t i = 0; i < e.properties.size(); ++i)
@@ -187,8 +202,8 @@ PolygonMesh readPly(std::string_view bytes, const std::string& name) {
   const bool hasNormals = normal[0] >= 0 && normal[1] >= 0 && normal[2] >= 0;
   for (const Element& e : h.elements)
     for (const Property& p : e.properties)
-      if (e.name == "face" && p.list && (p.name == "vertex_indices" || p.name == "vertex_index") && !integral(p.type))
-        headerText.fail("the face element's " + p.name + " list must have an integer type");
+      if (isIndexList(e, p) && !integral(p.type))
+        headerText.fail("the " + e.name + " element's " + p.name + " list must have an integer type");
   int uv[2] = {-1, -1};
   for (const auto& [u, v] : {std::pair{"s", "t"}, {"u", "v"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}})
     if (uv[0] < 0 && indexOf(*vertices, u) >= 0 && indexOf(*vertices, v) >= 0) uv[0] = indexOf(*vertices, u), uv[1] = indexOf(*vertices, v);
@@ -196,9 +211,10 @@ PolygonMesh readPly(std::string_view bytes, const std::string& name) {
   PolygonMesh out;
   Body body(bytes, h, name);
   std::vector<double> values;
+  std::vector<unsigned> strip;
   for (const Element& e : h.elements) {
     if (e.properties.empty()) continue;  // its instances hold no bytes
-    const bool isVertex = &e == vertices, isFace = e.name == "face";
+    const bool isVertex = &e == vertices, isStrips = e.name == "tristrips";
     for (int64_t i = 0; i < e.count; ++i) {
       const size_t start = body.position();
       values.assign(e.properties.size(), 0.0);
@@ -209,17 +225,24 @@ PolygonMesh readPly(std::string_view bytes, const std::string& name) {
           continue;
         }
         const int64_t n = body.length(prop);
-        const bool indices = isFace && (prop.name == "vertex_indices" || prop.name == "vertex_index");
-        if (indices) out.faceSizes.push_back(static_cast<unsigned>(n));
+        const bool indices = isIndexList(e, prop);
+        if (indices && !isStrips) out.faceSizes.push_back(static_cast<unsigned>(n));
+        strip.clear();
         for (int64_t k = 0; k < n; ++k) {
           const size_t at = body.position();
           const double index = body.value(prop.type, prop.name.c_str());
           if (!indices) continue;
+          if (isStrips && index == -1) {  // a strip ends, the next begins
+            addStrip(strip, out);
+            strip.clear();
+            continue;
+          }
           if (index < 0 || index >= double(vertices->count))
-            body.failAt(at, "face " + std::to_string(i) + ": vertex index " + integerText(index) + " is out of range [0, " +
+            body.failAt(at, e.name + " " + std::to_string(i) + ": vertex index " + integerText(index) + " is out of range [0, " +
                             std::to_string(vertices->count) + ")");
-          out.indices.push_back(static_cast<unsigned>(index));
+          (isStrips ? strip : out.indices).push_back(static_cast<unsigned>(index));
         }
+        if (indices && isStrips) addStrip(strip, out);
       }
       if (!isVertex) continue;
       for (int c = 0; c < 3; ++c) {

@@ -261,8 +261,11 @@ void qv_instance::saveSnapshot(double* out) const {
   std::memcpy(out + 1, q, sizeof(double) * r);
   std::memcpy(out + 1 + r, v, sizeof(double) * r);
   std::memcpy(out + 1 + 2 * r, a, sizeof(double) * r);
-  out[1 + 3 * r] = elasticEnergyAtState;
-  out[2 + 3 * r] = energySlack;
+  // The minimiser's energy budget; other solvers keep no account of E(q), so theirs is written as a
+  // minimising instance restored from it must start (a new budget from this state).
+  const bool budgeted = config.solver == QV_SOLVER_MINIMIZE && config.integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES;
+  out[1 + 3 * r] = budgeted ? elasticEnergyAtState : quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
+  out[2 + 3 * r] = budgeted ? energySlack : 0.0;
   if (flying()) {
     double* f = out + 3 + 3 * r;
     std::memcpy(f, frame.position, 3 * sizeof(double));

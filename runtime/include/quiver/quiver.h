@@ -160,7 +160,7 @@ typedef enum qv_solver {
                              motion, no line search, C = alpha I + beta K(q): the fastest while the strains stay
                              moderate. Where they do not (stiff springs, large twists, long time steps, sudden loads
                              and releases), the iterations add energy and can diverge: a step whose system is not
-                             positive definite, or whose end would move a vertex farther than max_displacement, is
+                             positive definite, or whose end may move a vertex farther than max_displacement, is
                              taken by the minimising solver instead (at most 8 iterations; qv_step_report.minimized),
                              so it does not reset on finite input either; the energy the fixed steps add stays. */
   QV_SOLVER_COUNT
@@ -189,7 +189,7 @@ typedef struct qv_instance_config {
   double rayleigh_alpha;     /* 1/s, >= 0; default: the model's */
   double rayleigh_beta;      /* s, >= 0; default: the model's */
   int max_constraints;       /* penalty constraint slots (drag springs, pinned groups), 0..64; default 4 */
-  double max_displacement;   /* m; a step that would move a vertex farther: QV_SOLVER_NEWTON takes it with the minimising
+  double max_displacement;   /* m; a step that may move a vertex farther (a bound through |q|): QV_SOLVER_NEWTON takes it with the minimising
                                 solver instead (so every step, at about 3x the cost, while a load holds the object
                                 past it), central differences reset the instance; default 100 x the model's diagonal */
   qv_elasticity elasticity;  /* default QV_ELASTICITY_STVK */
@@ -218,7 +218,7 @@ typedef enum qv_step_status {
   QV_STEP_INDEFINITE = 1, /* the minimising solver (by choice, or taking a QV_SOLVER_NEWTON step) met a system matrix
                              made indefinite by large compression, and shifted it to positive definite */
   QV_STEP_RESET = 2       /* the state became non-finite (non-finite loads or state set), or central differences
-                             moved a vertex farther than max_displacement: the instance was reset to rest */
+                             may have moved a vertex farther than max_displacement: the instance was reset to rest */
 } qv_step_status;
 
 /* Advances one time step under the loads set so far; per-step loads are then cleared. */
@@ -234,7 +234,7 @@ typedef struct qv_step_report {
                               end with, so it was drawn back toward the start (the velocity keeps what is left) */
   double energy_removed;   /* QV_SOLVER_MINIMIZE: kinetic energy (J) the step took out so as not to add energy */
   int minimized;           /* QV_SOLVER_NEWTON: 1 when the minimising solver took the step (the Newton system was not
-                              positive definite, or the step would have moved a vertex past max_displacement); the
+                              positive definite, or the step may have moved a vertex past max_displacement); the
                               fields above then describe its step */
 } qv_step_report;
 QV_API void qv_instance_last_step(const qv_instance* instance, qv_step_report* report);
@@ -250,7 +250,9 @@ QV_API void qv_instance_last_step(const qv_instance* instance, qv_step_report* r
    sharing every evaluation of their iterations and line searches (the energy budget's rare
    draw-back evaluates alone). The sums run in another
    order than one instance's, so states agree with qv_instance_step() to rounding, not bit for bit
-   (docs/architecture.md, "Many instances"); they do not depend on the number of jobs when every
+   (docs/architecture.md, "Many instances"), except from a QV_SOLVER_NEWTON step the minimiser took
+   over (qv_step_report.minimized) on: such a step amplifies rounding, and whether it is taken over
+   can itself differ; they do not depend on the number of jobs when every
    instance is groupable. Do not pass instances that are in a qv_world: the world steps them.
 
    No allocation: `scratch` (64-byte aligned) holds qv_instances_step_scratch_size(model, jobs)

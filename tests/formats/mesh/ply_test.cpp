@@ -124,6 +124,25 @@ TEST(PlyReader, BinaryDataThatBeginsWithALineEndByteReadsRight) {
   EXPECT_EQ(s.positions[0], double(cube.positions[0][0]));
 }
 
+TEST(PlyReader, TriangleStripsBecomeTrianglesThatWindAlike) {
+  // Two unit squares, z = 0 and z = 1, as strips 0 1 3 2 and 4 5 7 6 in one list, and a third
+  // strip whose one triangle is degenerate and dropped.
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+      "element tristrips 1\nproperty list int int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+      "13 0 1 3 2 -1 4 5 7 6 -1 0 0 1\n";
+  const SurfaceMesh s = read(ply, "strips.ply");
+  const std::vector<int> expected = {0, 1, 3, 3, 1, 2, 4, 5, 7, 7, 5, 6};  // every other one turned
+  EXPECT_EQ(s.triangles, expected);
+  // All wind alike: each triangle's normal points along +z.
+  for (size_t t = 0; t < s.triangles.size(); t += 3) {
+    const auto at = [&](int k, int c) { return s.positions[3 * s.triangles[t + k] + c]; };
+    const double nz = (at(1, 0) - at(0, 0)) * (at(2, 1) - at(0, 1)) - (at(1, 1) - at(0, 1)) * (at(2, 0) - at(0, 0));
+    EXPECT_GT(nz, 0) << "triangle " << t / 3;
+  }
+}
+
 TEST(PlyReader, AssimpsTestModelsReadAsAssimpsOwnImporterReadsThem) {
   const std::filesystem::path folder = "/usr/share/assimp/models/PLY";
   if (!std::filesystem::exists(folder)) GTEST_SKIP() << "Debian's assimp-testmodels is not installed: " << folder;
@@ -174,6 +193,9 @@ TEST(PlyReader, MalformedFilesAreRefusedNamingTheLineOrByte) {
   std::string floatCount = ascii;
   floatCount.replace(floatCount.find("list uchar int"), 14, "list float int");
   expectRefused(floatCount, "(a list's count type integral)");
+  std::string negative = ascii;
+  negative.replace(negative.find("4 0 3 2 1"), 9, "-1 0 3 2 1");
+  expectRefused(negative, ":27: the list vertex_indices counts -1 items");
   std::string floatIndices = ascii;
   floatIndices.replace(floatIndices.find("list uchar int"), 14, "list uchar float");
   expectRefused(floatIndices, ":17: the face element's vertex_indices list must have an integer type");
