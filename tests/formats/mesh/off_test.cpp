@@ -84,26 +84,16 @@ TEST(OffReader, MalformedFilesAreRefusedNamingTheLine) {
   expectRefused("OFF\n3 1000000000000000000000000000000 0\n", "bad.off:2: expected a whole number for the faces");
   // Counts a file cannot hold allocate nothing: reading stops at its end.
   expectRefused("OFF\n4 7777777777776 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n", "unexpected end of file while reading a face");
-  std::string outOfRange = cube("OFF\n8 6 12");
-  outOfRange.replace(outOfRange.find("4 0 3 2 1"), 9, "4 0 3 2 8");
-  expectRefused(outOfRange, "bad.off:11: face 0: vertex index 8 is out of range [0, 8)");
-  std::string shortFace = cube("OFF\n8 6 12");
-  shortFace.replace(shortFace.find("4 0 3 2 1"), 9, "5 0 3 2 1");
-  expectRefused(shortFace, "bad.off:11: face 0 counts 5 vertices; its line lists 4 numbers");
-  std::string shortVertex = cube("NOFF\n8 6 12", " 0 0 1");
-  shortVertex.replace(shortVertex.find("0 0 0 0 0 1"), 11, "0 0 0 0 0");
-  expectRefused(shortVertex, "bad.off:3: vertex 0: 5 numbers, fewer than the 6 the header's keyword asks for");
+  expectRefused(test::edited(cube("OFF\n8 6 12"), "4 0 3 2 1", "4 0 3 2 8"), "bad.off:11: face 0: vertex index 8 is out of range [0, 8)");
+  expectRefused(test::edited(cube("OFF\n8 6 12"), "4 0 3 2 1", "5 0 3 2 1"), "bad.off:11: face 0 counts 5 vertices; its line lists 4 numbers");
+  expectRefused(test::edited(cube("NOFF\n8 6 12", " 0 0 1"), "0 0 0 0 0 1", "0 0 0 0 0"), "bad.off:3: vertex 0: 5 numbers, fewer than the 6 the header's keyword asks for");
   expectRefused("XOFF\n8 6 12\n", "bad.off:1: unknown header keyword 'XOFF'");
   expectRefused("nOFF\n4\n8 6 12\n", "bad.off:2: a dimension of 4; 1, 2 or 3 are read here");
   expectRefused("nOFF\n4294967299\n8 6 12\n", "bad.off:2: a dimension of 4294967299");
   expectRefused("OFF\n8\n", "bad.off:2: expected the counts 'VERTICES FACES [EDGES]'");
   expectRefused("OFF\n", "unexpected end of file while reading the counts");
-  std::string notANumber = cube("OFF\n8 6 12");
-  notANumber.replace(notANumber.find("1 0 0"), 5, "1 zero 0");
-  expectRefused(notANumber, "bad.off:4: expected a number for a coordinate, found 'zero'");
-  std::string tooLarge = cube("OFF\n8 6 12");
-  tooLarge.replace(tooLarge.find("1 0 0"), 5, "1e39 0 0");
-  expectRefused(tooLarge, "bad.off:4: vertex 1: a coordinate is not a finite float");
+  expectRefused(test::edited(cube("OFF\n8 6 12"), "1 0 0", "1 zero 0"), "bad.off:4: expected a number for a coordinate, found 'zero'");
+  expectRefused(test::edited(cube("OFF\n8 6 12"), "1 0 0", "1e39 0 0"), "bad.off:4: vertex 1: a coordinate is not a finite float");
   expectRefused("4OFF\n3 1 0\n0 0 0 0\n1 0 0 1\n0 1 0 1\n3 0 1 2\n", "bad.off:3: vertex 0: a coordinate is not a finite float");
 }
 

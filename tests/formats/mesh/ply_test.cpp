@@ -168,43 +168,27 @@ TEST(PlyReader, MalformedFilesAreRefusedNamingTheLineOrByte) {
   ASSERT_EQ(huge[firstFace], 4);
   huge[firstFace] = '\xff';
   expectRefused(huge, "byte " + std::to_string(firstFace) + ": the list vertex_indices counts 255 items, more than the bytes left");
-  std::string hugeAscii = ascii;
-  hugeAscii.replace(hugeAscii.find("4 0 3 2 1"), 1, "200000000");
-  expectRefused(hugeAscii, ":27: the list vertex_indices counts 200000000 items");
+  expectRefused(test::edited(ascii, "4 0 3 2 1", "200000000 0 3 2 1"), ":27: the list vertex_indices counts 200000000 items");
 
   expectRefused(good.substr(0, good.size() - 3), "the list weights counts 1 items, more than the bytes left");
   expectRefused(good.substr(0, good.size() - 5), "unexpected end of file while reading weights");
-  std::string outOfRange = ascii;
-  outOfRange.replace(outOfRange.find("4 0 3 2 1"), 9, "4 0 3 2 8");
-  expectRefused(outOfRange, ":27: face 0: vertex index 8 is out of range [0, 8)");
+  expectRefused(test::edited(ascii, "4 0 3 2 1", "4 0 3 2 8"), ":27: face 0: vertex index 8 is out of range [0, 8)");
   // Found by fuzz.surface: a value no integer type holds, in the message.
-  outOfRange.replace(outOfRange.find("4 0 3 2 8"), 9, "4 0 3 2 1" + std::string(91, '0'));
-  expectRefused(outOfRange, ":27: face 0: vertex index 1e+91 is out of range [0, 8)");
-  std::string notInteger = ascii;
-  notInteger.replace(notInteger.find("4 0 3 2 1"), 9, "4 0 3 2 1.5");
-  expectRefused(notInteger, ":27: vertex_indices 1.5");
+  expectRefused(test::edited(ascii, "4 0 3 2 1", "4 0 3 2 1" + std::string(91, '0')),
+                ":27: face 0: vertex index 1e+91 is out of range [0, 8)");
+  expectRefused(test::edited(ascii, "4 0 3 2 1", "4 0 3 2 1.5"), ":27: vertex_indices 1.5");
 
   const std::string noEnd = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n";
   expectRefused(noEnd, "no end_header line");
   expectRefused("PLY\n" + ascii.substr(4), "bad.ply:1: not a PLY file");
-  std::string badType = ascii;
-  badType.replace(badType.find("property float y"), 16, "property real y");
-  expectRefused(badType, ":6: expected 'property TYPE NAME'");
-  std::string floatCount = ascii;
-  floatCount.replace(floatCount.find("list uchar int"), 14, "list float int");
-  expectRefused(floatCount, "(a list's count type integral)");
-  std::string negative = ascii;
-  negative.replace(negative.find("4 0 3 2 1"), 9, "-1 0 3 2 1");
-  expectRefused(negative, ":27: the list vertex_indices counts -1 items");
-  std::string floatIndices = ascii;
-  floatIndices.replace(floatIndices.find("list uchar int"), 14, "list uchar float");
-  expectRefused(floatIndices, ":17: the face element's vertex_indices list must have an integer type");
+  expectRefused(test::edited(ascii, "property float y", "property real y"), ":6: expected 'property TYPE NAME'");
+  expectRefused(test::edited(ascii, "list uchar int", "list float int"), "(a list's count type integral)");
+  expectRefused(test::edited(ascii, "4 0 3 2 1", "-1 0 3 2 1"), ":27: the list vertex_indices counts -1 items");
+  expectRefused(test::edited(ascii, "list uchar int", "list uchar float"), ":17: the face element's vertex_indices list must have an integer type");
   std::string binaryOutOfRange = good;  // named at the index's own first byte
   binaryOutOfRange[firstFace + 1 + 4 * 3] = 8;
   expectRefused(binaryOutOfRange, "byte " + std::to_string(firstFace + 1 + 4 * 3) + ": face 0: vertex index 8 is out of range");
-  std::string tooLarge = ascii;
-  tooLarge.replace(tooLarge.find("0 0 0 200"), 9, "1e39 0 0 200");
-  expectRefused(tooLarge, ":18: vertex 0: coordinate 1e+39 is not a finite float");
+  expectRefused(test::edited(ascii, "0 0 0 200", "1e39 0 0 200"), ":18: vertex 0: coordinate 1e+39 is not a finite float");
   expectRefused("ply\nformat ascii 1.0\nproperty float x\nend_header\n", ":3: a property before any element");
   expectRefused("ply\nformat ascii 1.0\nelement vertex 3000000000\nproperty float x\nend_header\n", ":3: expected 'element NAME COUNT'");
   // Counts a file cannot hold allocate nothing: reading stops at the file's end.

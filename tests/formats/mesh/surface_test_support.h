@@ -50,6 +50,13 @@ inline bool expectReadsAsAssimpsOwnImporter(const std::string& path) {
   return true;
 }
 
+// `text` with its first `from` replaced by `to`.
+inline std::string edited(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
+
 // readSurfaceMemory() refuses `bytes` in `format`: the message starts with `name` and says
 // `expected`.
 inline void expectSurfaceRefused(const std::string& bytes, const char* format, const std::string& name,
