@@ -43,7 +43,7 @@ qv_step_status stepImplicitNewmark(qv_instance& s) {
   if (s.config.solver == QV_SOLVER_MINIMIZE) return minimizing(s);
   const double h = s.config.time_step, beta = kNewmarkBeta, gamma = kNewmarkGamma;
   const int r = s.r;
-  double *q = s.q, *v = s.v, *a = s.a;
+  const double *q = s.q, *v = s.v, *a = s.a;
   std::memcpy(s.end.a, a, sizeof(double) * r);
   for (int it = 0; it < s.config.newton_iterations; ++it, ++s.lastStep.newton_iterations) {
     for (int i = 0; i < r; ++i) {
@@ -63,11 +63,7 @@ qv_step_status stepImplicitNewmark(qv_instance& s) {
     s.end.q[i] = q[i] + (h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * s.end.a[i]));
     s.end.v[i] = v[i] + h * ((1 - gamma) * a[i] + gamma * s.end.a[i]);
   }
-  if (!s.withinBounds(s.end.q, s.end.v, s.end.a)) return minimizedInstead(s, minimizing);
-  std::memcpy(q, s.end.q, sizeof(double) * r);
-  std::memcpy(v, s.end.v, sizeof(double) * r);
-  std::memcpy(a, s.end.a, sizeof(double) * r);
-  return QV_STEP_OK;
+  return endFixedNewton(s, minimizing);
 }
 
 } // namespace quiver::rt

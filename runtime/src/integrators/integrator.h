@@ -1,6 +1,8 @@
 #pragma once
 // Time integrators. Each lives in its own file as one function that advances an instance by one
 // step; adding one means its file, a value of qv_integrator and a row of kIntegrators.
+#include <cstring>
+
 #include "../elasticity.h"
 #include "../instance.h"
 #include "incremental_potential.h"
@@ -61,6 +63,15 @@ inline qv_step_status minimizedInstead(qv_instance& s, StepFunction minimizing) 
   s.elasticEnergyAtState = elasticEnergy(*s.model, s.config.elasticity, s.q, s.work.polynomialScratch);
   s.energySlack = 0;
   return minimizing(s);
+}
+// The end of a fixed Newton step (s.end): taken, or, past max_displacement or not finite, the
+// minimiser's step instead.
+inline qv_step_status endFixedNewton(qv_instance& s, StepFunction minimizing) {
+  if (!s.withinBounds(s.end.q, s.end.v, s.end.a)) return minimizedInstead(s, minimizing);
+  std::memcpy(s.q, s.end.q, sizeof(double) * s.r);
+  std::memcpy(s.v, s.end.v, sizeof(double) * s.r);
+  std::memcpy(s.a, s.end.a, sizeof(double) * s.r);
+  return QV_STEP_OK;
 }
 qv_step_status stepBackwardEuler(qv_instance& s);
 qv_step_status stepCentralDifferences(qv_instance& s);
