@@ -14,6 +14,7 @@
 
 #include "common/mesh_error.h"
 #include "common/surface_check.h"
+#include "formats/mesh/byte_cursor.h"
 #include "formats/mesh/read_mesh.h"
 #include "formats/mesh/read_surface.h"
 #include "tests/formats/mesh/surface_test_support.h"
@@ -45,9 +46,7 @@ template <class T>
 void put(std::string& out, T value, bool bigEndian) {
   char raw[sizeof(T)];
   std::memcpy(raw, &value, sizeof(T));
-  const uint16_t one = 1;
-  const bool hostLittle = *reinterpret_cast<const unsigned char*>(&one) == 1;
-  if (bigEndian == hostLittle)
+  if (bigEndian == hostIsLittleEndian())
     for (size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(raw[i], raw[sizeof(T) - 1 - i]);
   out.append(raw, sizeof(T));
 }
