@@ -81,7 +81,7 @@ def compare(apps, tmp, mesh, constraints, material, scenario):
         modal + "_modes.modes.npy", "--quiet", "-o", modal)
     # Reduced StVK with both solvers: Newton iterations damp with beta K(q), as the full-space reference
     # does, but two fixed ones can run away after a large twist's release; the default, minimising
-    # solver cannot, but damps with beta K(0), which also damps large rotations.
+    # solver cannot, and damps with K at each step's start (one step behind).
     fixed = ["--solver", "newton", "--newton", "2"]
     for name, qvr, elasticity, solver in (("reduced StVK (r = 30, modes + derivatives), default solver", model, "stvk", []),
                                           ("reduced StVK (r = 30, modes + derivatives), 2 fixed Newton iterations", model,

@@ -10,12 +10,32 @@ namespace quiver::rt {
 
 void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales& scales) {
   const int r = s.r;
-  const double* K0 = s.model->restStiffness;
+  const double* D = s.dampingStiffness;
   for (int i = 0; i < r; ++i)
     for (int j = i; j < r; ++j)
       s.work.system[i * r + j] = scales.stiffness * s.work.stiffness[i * r + j] +
-                                 scales.stateJacobian * stateJacobian[i * r + j] + scales.restStiffness * K0[i * r + j] +
-                                 (i == j ? scales.identity : 0.0);
+                                 scales.stateJacobian * stateJacobian[i * r + j] +
+                                 scales.dampingStiffness * D[i * r + j] + (i == j ? scales.identity : 0.0);
+}
+
+void dampWithStiffness(const qv_instance& s, const double* K, double* D) {
+  const int r = s.r;
+  double largest = 0;
+  for (int i = 0; i < r; ++i) largest = std::fmax(largest, std::fabs(K[i * r + i]));
+  double* trial = s.work.system;  // free between steps, where D is set
+  double mu = 0;
+  for (int rung = 0; rung <= 40; ++rung) {
+    for (int i = 0; i < r; ++i)
+      for (int j = i; j < r; ++j) trial[i * r + j] = K[i * r + j] + (i == j ? mu : 0.0);
+    if (choleskyFactor(trial, r)) {
+      if (D != K) std::memcpy(D, K, sizeof(double) * r * r);
+      for (int i = 0; i < r; ++i) D[i * r + i] += mu;
+      return;
+    }
+    if (!(largest > 0) || !std::isfinite(largest)) break;
+    mu = rung > 0 ? 4 * mu : 1e-6 * largest;
+  }
+  std::memcpy(D, s.model->restStiffness, sizeof(double) * r * r);
 }
 
 QV_HOT void dampingForces(const qv_instance& s, const double* K, const double* v, double* out) {

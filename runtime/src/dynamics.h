@@ -17,7 +17,7 @@ void elasticityAt(qv_instance& s, const double* q, double* energy, double* force
 const double* evaluateForces(qv_instance& s, const double* q);
 
 // C v = alpha v + beta K v into `out` (r values), K the elastic stiffness last evaluated (or, for
-// the minimising solver's C0, K(0)): K is symmetric, so the product runs along its rows as axpys
+// the minimising solver, its damping stiffness D): K is symmetric, so the product runs along its rows as axpys
 // (SIMD across i), each sum over j in order, instead of r chains of r dependent multiply-adds.
 void dampingForces(const qv_instance& s, const double* K, const double* v, double* out);
 inline void dampingForces(const qv_instance& s, const double* v, double* out) {
@@ -30,6 +30,11 @@ inline void dampingForces(const qv_instance& s, const double* v, double* out) {
 inline SystemScales newtonSystem(const qv_instance& s, double c1, double c2) {
   return {std::fma(c1, s.config.rayleigh_beta, c2), c2, 0.0, std::fma(c1, s.config.rayleigh_alpha, 1.0)};
 }
+
+// D = K + mu I into `D` (may be K), K symmetric (r x r), mu the smallest of 0 and a ladder
+// from 1e-6 of K's largest diagonal entry, each rung 4x the last (40 at most), that makes D positive definite
+// (a negative damping would add energy); K(0) where none does (K not finite: the step resets).
+void dampWithStiffness(const qv_instance& s, const double* K, double* D);
 
 // The matrix's upper triangle (all Cholesky reads) into s.work.system.
 void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales& scales);

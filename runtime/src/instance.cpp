@@ -6,6 +6,7 @@
 #include <new>
 
 #include "contact.h"
+#include "dense_solve.h"
 #include "dynamics.h"
 #include "elasticity.h"
 #include "integrators/integrator.h"
@@ -99,6 +100,7 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
   q = c.take<double>(r);
   v = c.take<double>(r);
   a = c.take<double>(r);
+  dampingStiffness = c.take<double>(rr);
   loads.carve(c, r, config.max_constraints, flying());
   end.q = c.take<double>(r);
   end.v = c.take<double>(r);
@@ -133,6 +135,7 @@ void qv_instance::rest() {
   std::memset(a, 0, sizeof(double) * r);
   elasticEnergyAtState = 0;
   energySlack = 0;
+  quiver::rt::dampWithStiffness(*this, model->restStiffness, dampingStiffness);
   contacts.clear();
   if (flying()) frame.goHome();
 }
@@ -252,8 +255,16 @@ void qv_instance::setState(const double* newQ, const double* newV, const double*
     quiver::rt::dampingForces(*this, v, work.damping);
     for (int i = 0; i < r; ++i) a[i] = loads.gravityForce[i] - work.force[i] - work.damping[i];
   }
-  if (newQ) elasticEnergyAtState = quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
+  if (newQ) {
+    elasticEnergyAtState = quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
+    dampingStiffnessAtState(dampingStiffness);
+  }
   energySlack = 0;
+}
+
+void qv_instance::dampingStiffnessAtState(double* D) const {
+  quiver::rt::evaluateElasticity(*model, config.elasticity, q, nullptr, work.force, work.stiffness, work.polynomialScratch);
+  quiver::rt::dampWithStiffness(*this, work.stiffness, D);
 }
 
 void qv_instance::saveSnapshot(double* out) const {
@@ -266,18 +277,36 @@ void qv_instance::saveSnapshot(double* out) const {
   const bool budgeted = config.solver == QV_SOLVER_MINIMIZE && config.integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES;
   out[1 + 3 * r] = budgeted ? elasticEnergyAtState : quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
   out[2 + 3 * r] = budgeted ? energySlack : 0.0;
+  double* f = out + 3 + 3 * r;
   if (flying()) {
-    double* f = out + 3 + 3 * r;
     std::memcpy(f, frame.position, 3 * sizeof(double));
     std::memcpy(f + 3, frame.orientation, 4 * sizeof(double));
     std::memcpy(f + 7, frame.velocity, 3 * sizeof(double));
     std::memcpy(f + 10, frame.angularMomentum, 3 * sizeof(double));
     std::memcpy(f + 13, frame.lastBodyOmega, 3 * sizeof(double));
+    f += 16;
   }
+  // D, likewise: the minimiser's, or the one it would start from here. Written, not recomputed on
+  // restoring: a group evaluates K(q) in a different order than one instance does, so only the
+  // saved bits repeat the same steps.
+  const double* D = dampingStiffness;
+  if (!budgeted) {
+    dampingStiffnessAtState(work.stiffness);
+    D = work.stiffness;
+  }
+  for (int i = 0; i < r; ++i)
+    for (int j = i; j < r; ++j) *f++ = D[i * r + j];
 }
 
 bool qv_instance::restoreSnapshot(const double* in) {
   if (in[0] != r) return false;
+  // D must be positive definite, or the damping would add energy: checked before anything changes.
+  const double* savedD = in + 3 + 3 * r + (flying() ? 16 : 0);
+  for (int i = 0, k = 0; i < r; ++i)
+    for (int j = i; j < r; ++j) work.system[i * r + j] = savedD[k++];
+  if (!quiver::rt::choleskyFactor(work.system, r)) return false;
+  for (int i = 0, k = 0; i < r; ++i)
+    for (int j = i; j < r; ++j, ++k) dampingStiffness[i * r + j] = dampingStiffness[j * r + i] = savedD[k];
   std::memcpy(q, in + 1, sizeof(double) * r);
   std::memcpy(v, in + 1 + r, sizeof(double) * r);
   std::memcpy(a, in + 1 + 2 * r, sizeof(double) * r);

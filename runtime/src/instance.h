@@ -19,11 +19,11 @@ struct EndOfStep {
 };
 
 // The symmetric matrices both solvers factorise (dynamics.h): stiffness K(q) + stateJacobian J +
-// restStiffness K(0) + identity I, each term scaled.
+// dampingStiffness D (qv_instance) + identity I, each term scaled.
 struct SystemScales {
-  double stiffness = 0, stateJacobian = 0, restStiffness = 0, identity = 0;
+  double stiffness = 0, stateJacobian = 0, dampingStiffness = 0, identity = 0;
   bool operator==(const SystemScales& o) const {
-    return stiffness == o.stiffness && stateJacobian == o.stateJacobian && restStiffness == o.restStiffness &&
+    return stiffness == o.stiffness && stateJacobian == o.stateJacobian && dampingStiffness == o.dampingStiffness &&
            identity == o.identity;
   }
 };
@@ -79,6 +79,10 @@ struct qv_instance {
   double *q, *v, *a;
   double elasticEnergyAtState;  // E(q) for the minimising solver's energy budget (fixed Newton steps leave it stale)
   double energySlack;           // energy the discretisation lost that a later step may win back
+  // D, r x r: the minimising solver's Rayleigh damping C = alpha I + beta D through a step. K(q) at
+  // the step's start, shifted to positive definite where compression made it indefinite
+  // (dampWithStiffness(), dynamics.h).
+  double* dampingStiffness;
   qv_step_report lastStep;
   quiver::rt::Loads loads;
   quiver::rt::EndOfStep end;
@@ -101,6 +105,9 @@ struct qv_instance {
   // One step of the configured integrator; per-step loads are spent; a blown-up state resets.
   qv_step_status step();
   void setState(const double* q, const double* v, const double* a);
+  // D from K(q) into `D` (r x r; may be work.stiffness), as a minimising step that ended at q would
+  // leave it: for a state set from outside (setState(), a fixed Newton step the minimiser takes over).
+  void dampingStiffnessAtState(double* D) const;
   bool flying() const { return config.free_flight != 0; }
   // A world force on a vertex: on q (and, in flight, on the frame).
   void addVertexForce(int vertex, const double force[3]);
@@ -114,8 +121,12 @@ struct qv_instance {
   void moveFrame();              // in flight, the frame's move over the step, before q's
   qv_step_status endStep(qv_step_status status);  // the per-step loads are spent; a blown-up state resets
   // The snapshot: r, then q, v, a, E(q) and the energy slack, then in flight the frame (position,
-  // orientation, velocity, angular momentum, last body omega), as doubles.
-  size_t snapshotSize() const { return sizeof(double) * (3 * static_cast<size_t>(r) + 3 + (flying() ? 16 : 0)); }
+  // orientation, velocity, angular momentum, last body omega), then D's upper triangle row by row,
+  // as doubles.
+  size_t snapshotSize() const {
+    const size_t n = static_cast<size_t>(r);
+    return sizeof(double) * (3 * n + 3 + (flying() ? 16 : 0) + n * (n + 1) / 2);
+  }
   void saveSnapshot(double* out) const;
   bool restoreSnapshot(const double* in);
   void energies(double* kinetic, double* elastic) const;

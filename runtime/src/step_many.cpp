@@ -48,18 +48,19 @@ QV_HOT void unpackSymmetric(const double* lanes, int r, int count, double* const
 // factorise the identity.
 QV_HOT void factoriseGroup(qv_instance* const* group, int count, const SystemScales* scales, double* A) {
   const int r = group[0]->r;
-  const double* K0 = group[0]->model->restStiffness;
   SystemScales lane[kLanes];
   const double* J[kLanes];
-  bool any = false, constrained = false, rest = false;
+  const double* D[kLanes];
+  bool any = false, constrained = false, damped = false;
   for (int l = 0; l < kLanes; ++l) {
     const qv_instance& s = *group[l < count ? l : 0];
     const bool factorised = l < count && factorisedInGroup(s);
     lane[l] = factorised ? scales[l] : SystemScales{0.0, 0.0, 0.0, 1.0};
     J[l] = s.loads.constraintK;  // zero while no constraint is active
+    D[l] = s.dampingStiffness;
     any = any || factorised;
     constrained = constrained || (factorised && s.loads.constrained);
-    rest = rest || lane[l].restStiffness != 0;
+    damped = damped || lane[l].dampingStiffness != 0;
   }
   for (int l = 0; l < count; ++l) group[l]->work.presetFactor = LaneFactor{};
   if (!any) return;
@@ -70,8 +71,8 @@ QV_HOT void factoriseGroup(qv_instance* const* group, int count, const SystemSca
       for (int l = 0; l < kLanes; ++l) x[l] *= lane[l].stiffness;
       if (constrained)
         for (int l = 0; l < kLanes; ++l) x[l] += lane[l].stateJacobian * J[l][a * r + b];
-      if (rest)
-        for (int l = 0; l < kLanes; ++l) x[l] += lane[l].restStiffness * K0[a * r + b];
+      if (damped)
+        for (int l = 0; l < kLanes; ++l) x[l] += lane[l].dampingStiffness * D[l][a * r + b];
       if (a == b)
         for (int l = 0; l < kLanes; ++l) x[l] += lane[l].identity;
     }

@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -37,7 +39,7 @@ TEST(Solver, AConvergedStepSolvesTheIntegratorsEquations) {
     qv_instance_config config;
     qv_instance_config_init(&config, m.model);
     config.integrator = integrator;
-    config.rayleigh_alpha = 2;  // K-proportional damping differs on purpose between the solvers (K(0) / K(q))
+    config.rayleigh_alpha = 2;  // K-proportional damping differs on purpose between the solvers (K at the step's start / at its end)
     config.rayleigh_beta = 0;
     config.newton_iterations = 40;
     config.newton_tolerance = 1e-10;
@@ -151,47 +153,159 @@ TEST(Solver, TheReportSaysWhatTheStepDid) {
   EXPECT_EQ(report.newton_iterations, 3) << "Barbic & James: exactly the iterations asked for";
 }
 
-// The minimising Newmark step with Rayleigh damping C0 = alpha I + beta K(0) against Newmark written
-// out here on the full-space projections U^T R(Uq), U^T K(Uq) U, each step's equation solved to
-// convergence by Newton: M a' + C0 v' + R(q') = f with the trapezoidal updates.
-TEST(Solver, DampedNewmarkMatchesTheTrapezoidalRuleOnTheFullSpaceProjection) {
-  test::TestModel m;
-  ASSERT_NE(m.model, nullptr);
+namespace {
+
+// Which stiffness Rayleigh damping C = alpha I + beta K uses in newmarkOnTheProjection().
+enum class DampedWith { StepStart, EndOfStep, Rest };
+
+// Implicit Newmark written out on the full-space projections U^T R(Uq), U^T K(Uq) U, each step's
+// equation M a' + C v' + R(q') = f with the trapezoidal updates solved to convergence by Newton:
+// the tip pulled for `pulled` steps, then let go. Returns q and |v|^2/2 + E(q) after each step.
+struct Path {
+  std::vector<Eigen::VectorXd> q;
+  std::vector<double> energy;
+};
+Path newmarkOnTheProjection(const test::TestModel& m, const qv_instance_config& config,
+                                                    const double pull[3], int pulled, int steps, DampedWith damped) {
   const int r = m.info.r, tip = m.tipVertex();
-  qv_instance_config config;
-  qv_instance_config_init(&config, m.model);
-  config.rayleigh_alpha = 0.5;
-  config.rayleigh_beta = 0.01;
-  config.newton_iterations = 40;
-  config.newton_tolerance = 1e-10;
-  Instance inst(m.model, config);
-  const double h = config.time_step;
+  const double h = config.time_step, alpha = config.rayleigh_alpha, beta = config.rayleigh_beta;
+  const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(r, r);
   Eigen::VectorXd R;
-  Eigen::MatrixXd K0;
+  Eigen::MatrixXd K0, K, Kstart;
   m.exact(Eigen::VectorXd::Zero(r), R, K0);
-  const Eigen::MatrixXd C = config.rayleigh_alpha * Eigen::MatrixXd::Identity(r, r) + config.rayleigh_beta * K0;
-  const double pull[3] = {0, 1.0, -4.0};
   const Eigen::VectorXd tipForce = m.U.middleRows(3 * tip, 3).transpose() * Eigen::Map<const Eigen::Vector3d>(pull);
   Eigen::VectorXd q = Eigen::VectorXd::Zero(r), v = q, a = q;
-  Eigen::MatrixXd K;
-  double worst = 0, largest = 0;
-  for (int step = 0; step < 120; ++step) {
-    const Eigen::VectorXd f = step < 60 ? tipForce : Eigen::VectorXd::Zero(r);
-    if (step < 60) qv_instance_add_vertex_force(inst.s, tip, pull);
-    ASSERT_NE(qv_instance_step(inst.s), QV_STEP_RESET);
+  Path path;
+  for (int step = 0; step < steps; ++step) {
+    const Eigen::VectorXd f = step < pulled ? tipForce : Eigen::VectorXd::Zero(r);
+    m.exact(q, R, Kstart);
+    if (damped == DampedWith::StepStart) {
+      EXPECT_EQ(Kstart.llt().info(), Eigen::Success) << "step " << step << ": K(q) is indefinite, and the runtime shifts it";
+    }
     Eigen::VectorXd next = a;
     for (int it = 0; it < 30; ++it) {
       const Eigen::VectorXd qn = q + h * v + 0.25 * h * h * (a + next), vn = v + 0.5 * h * (a + next);
       m.exact(qn, R, K);
+      const Eigen::MatrixXd& D = damped == DampedWith::StepStart ? Kstart : damped == DampedWith::EndOfStep ? K : K0;
+      const Eigen::MatrixXd C = alpha * I + beta * D;
       const Eigen::VectorXd residual = next + C * vn + R - f;
-      next -= (Eigen::MatrixXd::Identity(r, r) + 0.5 * h * C + 0.25 * h * h * K).partialPivLu().solve(residual);
+      // The Jacobian of C(q') v' is left out when C follows the iterate: the fixed point is the same.
+      next -= (I + 0.5 * h * C + 0.25 * h * h * K).partialPivLu().solve(residual);
     }
     q += h * v + 0.25 * h * h * (a + next);
     v += 0.5 * h * (a + next);
     a = next;
-    worst = std::max(worst, (stateOf(inst.s, r, 0) - q).norm());
-    largest = std::max(largest, q.norm());
+    path.q.push_back(q);
+    path.energy.push_back(0.5 * v.squaredNorm() + m.full->energy(m.U * q));
+  }
+  return path;
+}
+
+// Rayleigh damping alpha I + beta K, each step solved far past the default tolerance, to be
+// compared with the references above.
+qv_instance_config convergedConfig(const test::TestModel& m, double alpha, double beta) {
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  config.rayleigh_alpha = alpha;
+  config.rayleigh_beta = beta;
+  config.newton_iterations = 40;
+  config.newton_tolerance = 1e-10;
+  return config;
+}
+
+} // namespace
+
+// The minimising Newmark step with Rayleigh damping C = alpha I + beta K(q_n), K at the step's start
+// (lagged), against Newmark written out on the full-space projection with the same damping.
+TEST(Solver, DampedNewmarkMatchesTheTrapezoidalRuleOnTheFullSpaceProjection) {
+  test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  const int r = m.info.r, tip = m.tipVertex();
+  const qv_instance_config config = convergedConfig(m, 0.5, 0.01);
+  Instance inst(m.model, config);
+  const double pull[3] = {0, 1.0, -4.0};
+  const std::vector<Eigen::VectorXd> reference = newmarkOnTheProjection(m, config, pull, 60, 120, DampedWith::StepStart).q;
+  double worst = 0, largest = 0;
+  for (int step = 0; step < 120; ++step) {
+    if (step < 60) qv_instance_add_vertex_force(inst.s, tip, pull);
+    ASSERT_NE(qv_instance_step(inst.s), QV_STEP_RESET);
+    worst = std::max(worst, (stateOf(inst.s, r, 0) - reference[step]).norm());
+    largest = std::max(largest, reference[step].norm());
   }
   EXPECT_LT(worst, 1e-7 * largest);
   EXPECT_GT(largest, 0.01);
+}
+
+// Bent (the tip pulled down by 8 N), then let go: the energy the minimiser's lagged damping
+// dissipates follows Newmark damped with K at each step's end, as Barbic & James's Newton
+// iterations and the full-space reference damp, and not with the rest stiffness (which over-damped
+// large rotations several times: bench/README.md). The test's own check that it can tell them
+// apart: the rest-stiffness reference's energy is far from the end-of-step one's. (Bent farther,
+// the lag shows: at 12 N the minimiser is 10% of that gap from the end-of-step reference, at 20 N
+// 33%; it equals the lagged reference to rounding, DampedNewmarkMatchesTheTrapezoidalRule...)
+TEST(Solver, RayleighDampingFollowsTheBentStiffness) {
+  test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  const int tip = m.tipVertex();
+  const qv_instance_config config = convergedConfig(m, 0, 0.01);
+  Instance inst(m.model, config);
+  const double pull[3] = {0, 0, -8};
+  const int pulled = 60, steps = 150;
+  const Path endOfStep = newmarkOnTheProjection(m, config, pull, pulled, steps, DampedWith::EndOfStep);
+  const Path rest = newmarkOnTheProjection(m, config, pull, pulled, steps, DampedWith::Rest);
+  double worst = 0, apart = 0, largest = 0;
+  for (int step = 0; step < steps; ++step) {
+    if (step < pulled) qv_instance_add_vertex_force(inst.s, tip, pull);
+    ASSERT_NE(qv_instance_step(inst.s), QV_STEP_RESET);
+    if (step < pulled) continue;
+    worst = std::max(worst, std::fabs(totalEnergy(inst.s) - endOfStep.energy[step]));
+    apart = std::max(apart, std::fabs(rest.energy[step] - endOfStep.energy[step]));
+    largest = std::max(largest, endOfStep.energy[step]);
+  }
+  EXPECT_GT(apart, 0.15 * largest) << "the load must bend it far enough for K(q) to damp unlike K(0)";
+  EXPECT_LT(worst, 0.1 * apart);
+}
+
+// Set moving along K(q)'s most negative direction at a state where compression makes K(q)
+// indefinite (the most negative eigenvalue found along the basis vectors): the damping stiffness is
+// shifted to positive definite there, so damping only takes energy out; unshifted, beta K(q) would
+// put energy in along that direction, and the budget, which counts damping's share, would let it
+// (by a factor of 10^4 in the first step: checked by leaving the shift out).
+TEST(Solver, DampingFromAnIndefiniteStiffnessNeverAddsEnergy) {
+  test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  const int r = m.info.r;
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  config.rayleigh_alpha = 0;
+  config.rayleigh_beta = 0.05;
+  Instance inst(m.model, config);
+  Eigen::VectorXd R, q;
+  Eigen::MatrixXd K;
+  double lowest = 0;
+  for (int k = 0; k < r; ++k)
+    for (double t = 1e-3; t < 1e3; t *= 1.25)
+      for (double sign : {1.0, -1.0}) {
+        const Eigen::VectorXd x = sign * t * Eigen::VectorXd::Unit(r, k);
+        m.exact(x, R, K);
+        const double l = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(K, Eigen::EigenvaluesOnly).eigenvalues()(0);
+        if (l < lowest) {
+          lowest = l;
+          q = x;
+        }
+      }
+  ASSERT_LT(lowest, 0) << "no state along the basis vectors made K(q) indefinite";
+  m.exact(q, R, K);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(K);
+  const Eigen::VectorXd v = 10 * q.norm() * eigen.eigenvectors().col(0);  // lowest first
+  qv_instance_set_state(inst.s, q.data(), v.data(), nullptr);
+  double previous = totalEnergy(inst.s);
+  const double first = previous;
+  for (int step = 0; step < 100; ++step) {
+    ASSERT_NE(qv_instance_step(inst.s), QV_STEP_RESET);
+    const double energy = totalEnergy(inst.s);
+    EXPECT_LE(energy, previous + 1e-9 * first) << "step " << step;
+    previous = energy;
+  }
+  EXPECT_LT(previous, first);
 }

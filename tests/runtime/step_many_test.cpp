@@ -218,7 +218,7 @@ TEST(StepMany, StatesAgreeWithSteppingOneByOne) {
 TEST(StepMany, NewtonMatricesFactorisedInGroupsAgreeWithEachInstanceOwn) {
   // The group factorises the matrix each step solves with at each point it evaluates: the fixed
   // Newton step's I + c1 C + c2 (K + J) at the first guess (with a second iteration that must
-  // factorise its own at its own point), the minimiser's w I + K + J + s C0 at every iterate. Here
+  // factorise its own at its own point), the minimiser's w I + K + J + s C at every iterate (C from each instance's own damping stiffness). Here
   // with time steps, Rayleigh damping and held tips (J) that differ from lane to lane.
   quiver::test::TestModel m;
   ASSERT_NE(m.model, nullptr);
@@ -366,6 +366,38 @@ TEST(StepMany, JobsOnThreadsGiveTheSameStatesAsOneJob) {
   }
   // Each lane's sums are the same whichever group it sits in, and the jobs do not change the groups.
   for (int i = 0; i < count; ++i) EXPECT_EQ(one.state(i), two.state(i)) << "instance " << i;
+}
+
+// Snapshots carry the damping stiffness a group evaluated (a lane's sums are ordered unlike one
+// instance's), so a crowd restored from them repeats its steps bit for bit.
+TEST(StepMany, ACrowdRestoredFromItsSnapshotsRepeatsItsStepsBitForBit) {
+  quiver::test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  const int count = 11;
+  Crowd crowd(m, config, count);
+  size_t bytes = 0;
+  Scratch scratch = scratchFor(m.model, 1, bytes);
+  auto stepFrom = [&](int first) {
+    for (int step = first; step < first + 30; ++step) {
+      crowd.load(step);
+      ASSERT_EQ(qv_instances_step(crowd.instances.data(), count, nullptr, scratch.get(), bytes, nullptr), QV_OK);
+    }
+  };
+  stepFrom(0);
+  std::vector<std::vector<char>> snapshots;
+  for (qv_instance* s : crowd.instances) {
+    snapshots.emplace_back(qv_instance_snapshot_size(s));
+    qv_instance_save_snapshot(s, snapshots.back().data());
+  }
+  stepFrom(30);
+  std::vector<std::vector<double>> first;
+  for (int i = 0; i < count; ++i) first.push_back(crowd.state(i));
+  for (int i = 0; i < count; ++i)
+    ASSERT_EQ(qv_instance_restore_snapshot(crowd.instances[i], snapshots[i].data(), snapshots[i].size()), QV_OK);
+  stepFrom(30);
+  for (int i = 0; i < count; ++i) EXPECT_EQ(crowd.state(i), first[i]) << "instance " << i;
 }
 
 TEST(StepMany, OtherIntegratorsAndLoneInstancesStepAsAlone) {

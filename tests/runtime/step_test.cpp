@@ -287,6 +287,13 @@ TEST(Step, DeterministicAndStateRoundTrips) {
   EXPECT_EQ(0, std::memcmp(sa.data(), sb.data(), sizeof(double) * sa.size()));  // bit-identical
   // Rewind b to step 100 and replay: the same bits again.
   EXPECT_EQ(qv_instance_restore_snapshot(b.s, saved.data(), saved.size() * sizeof(double) - 1), QV_ERROR_INVALID_ARGUMENT);
+  // A damping stiffness that is not positive definite (it would add energy) is refused, and b is
+  // left as it was. The snapshot ends with its upper triangle; the last entry is D's (r, r).
+  std::vector<double> spoiled = saved;
+  spoiled.back() = -1;
+  EXPECT_EQ(qv_instance_restore_snapshot(b.s, spoiled.data(), spoiled.size() * sizeof(double)), QV_ERROR_INVALID_ARGUMENT);
+  qv_instance_get_state(b.s, sb.data(), sb.data() + r, sb.data() + 2 * r);
+  EXPECT_EQ(0, std::memcmp(sa.data(), sb.data(), sizeof(double) * sa.size()));
   ASSERT_EQ(qv_instance_restore_snapshot(b.s, saved.data(), saved.size() * sizeof(double)), QV_OK);
   for (int step = 101; step < 200; ++step) {
     qv_instance_add_vertex_force(b.s, m.tipVertex(), push);

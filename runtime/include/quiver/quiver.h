@@ -16,7 +16,7 @@ extern "C" {
 #endif
 
 #define QV_VERSION_MAJOR 0
-#define QV_VERSION_MINOR 8
+#define QV_VERSION_MINOR 9
 #define QV_VERSION_PATCH 0
 #define QV_VERSION_NUMBER (QV_VERSION_MAJOR * 10000 + QV_VERSION_MINOR * 100 + QV_VERSION_PATCH)
 
@@ -154,8 +154,10 @@ typedef enum qv_solver {
                              until the gradient is below newton_tolerance or after newton_iterations; the total
                              energy never grows within a step (what the integrator would add is taken out of the
                              velocity). No bounded load can make it run away: it resets only on non-finite input.
-                             Rayleigh damping uses the rest stiffness, C = alpha I + beta K(0). Costs about 3x a
-                             Newton step when one iteration converges (bench/README.md). */
+                             Rayleigh damping C = alpha I + beta K(q) uses K at the step's start (lagged, shifted to
+                             positive definite where compression made it indefinite), so it damps a bent object as
+                             the Newton iterations do. Costs about 3x a Newton step when one iteration converges
+                             (bench/README.md). */
   QV_SOLVER_NEWTON = 1,   /* Barbic & James 2005: exactly newton_iterations Newton iterations on the equations of
                              motion, no line search, C = alpha I + beta K(q): the fastest while the strains stay
                              moderate. Where they do not (stiff springs, large twists, long time steps, sudden loads
@@ -289,10 +291,12 @@ QV_API void qv_instance_get_state(const qv_instance* instance, double* q, double
 QV_API void qv_instance_set_state(qv_instance* instance, const double* q, const double* velocity,
                                   const double* acceleration);
 
-/* Everything that evolves (q, velocity, acceleration and the solver's energy budget) as an opaque
-   block of qv_instance_snapshot_size() bytes, for rewinding, replays and save games: restoring a
-   snapshot and repeating the same calls repeats the same bits. Restoring checks the size and that
-   the snapshot came from a model of the same r (QV_ERROR_INVALID_ARGUMENT otherwise). */
+/* Everything that evolves (q, velocity, acceleration, the solver's energy budget and its damping
+   stiffness, r (r + 1) / 2 values) as an opaque block of qv_instance_snapshot_size() bytes, for
+   rewinding, replays and save games: restoring a snapshot and repeating the same calls repeats the
+   same bits. Restoring checks the size, that the snapshot came from a model of the same r and that
+   its damping stiffness is positive definite (QV_ERROR_INVALID_ARGUMENT otherwise, the instance
+   unchanged). */
 QV_API size_t qv_instance_snapshot_size(const qv_instance* instance);
 QV_API void qv_instance_save_snapshot(const qv_instance* instance, void* snapshot);
 QV_API qv_result qv_instance_restore_snapshot(qv_instance* instance, const void* snapshot, size_t size);

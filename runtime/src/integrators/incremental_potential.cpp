@@ -34,7 +34,7 @@ public:
     pt.jacobian = s_.loads.addStateForces(x, s_.work.force, &S);
     double inertia = 0, external = 0, damping = 0, inertiaNorm = 0, forceNorm = 0, externalNorm = 0, dampingNorm = 0;
     for (int i = 0; i < r_; ++i) velocity_[i] = v0_[i] + p_.s * (x[i] - qt_[i]);
-    dampingForces(s_, s_.model->restStiffness, velocity_, s_.work.damping);
+    dampingForces(s_, s_.dampingStiffness, velocity_, s_.work.damping);
     for (int i = 0; i < r_; ++i) {
       const double d = x[i] - qt_[i], f = s_.loads.external(i), cv = s_.work.damping[i];
       inertia += d * d;
@@ -225,15 +225,19 @@ void MinimizeTask::iterate() {
 void MinimizeTask::finish() {
   qv_instance& s = *s_;
   const int r = s.r;
-  // Damping's share: h v_mid^T C0 v_mid, exact for the trapezoidal rule's linear damping.
+  // Damping's share: h v_mid^T C v_mid, exact for the trapezoidal rule's linear damping.
   double* mid = s.work.midpointVelocity;
   for (int i = 0; i < r; ++i) mid[i] = 0.5 * (s.v[i] + s.end.v[i]);
-  dampingForces(s, s.model->restStiffness, mid, s.work.damping);
+  dampingForces(s, s.dampingStiffness, mid, s.work.damping);
   for (int i = 0; i < r; ++i) budget_ -= p_.h * mid[i] * s.work.damping[i];
   holdToBudget(s, budget_, s.end.q, s.end.v, elastic_, s.lastStep);
   // A step held back forfeits the slack: what it removed is not to be won back.
   s.energySlack = s.lastStep.held_back ? 0.0 : std::fmax(0.0, budget_ - stepEnergy(s, s.end.q, s.end.v, elastic_));
   s.elasticEnergyAtState = elastic_;
+  // The next step damps with K at this end: the last evaluation's, unless the budget moved x.
+  if (s.lastStep.held_back)
+    evaluateElasticity(*s.model, s.config.elasticity, s.end.q, nullptr, s.work.force, s.work.stiffness, s.work.polynomialScratch);
+  dampWithStiffness(s, s.work.stiffness, s.dampingStiffness);
   phase_ = Phase::Done;
 }
 

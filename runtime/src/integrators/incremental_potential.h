@@ -1,21 +1,25 @@
 #pragma once
 // Implicit steps as minimisation (QV_SOLVER_MINIMIZE). Implicit Newmark (beta = 1/4, gamma = 1/2)
 // and backward Euler both make the end-of-step position x a stationary point of
-//   Phi(x) = w/2 |x - qt|^2 + E(x) + S(x) - f^T x + 1/(2s) v(x)^T C0 v(x),   v(x) = v0 + s (x - qt),
+//   Phi(x) = w/2 |x - qt|^2 + E(x) + S(x) - f^T x + 1/(2s) v(x)^T C v(x),   v(x) = v0 + s (x - qt),
 // with M = I, E the elastic energy, S the state forces' potential (loads.h), f this step's constant
-// forces and C0 = alpha I + beta K(0) (Rayleigh damping with the rest stiffness: a potential that is
-// never negative). grad Phi = 0 is the integrator's own equation; its Hessian is
-// w I + K(x) + J + s C0. Each step's predictor:
+// forces and C = alpha I + beta D, D the stiffness K(q) at the step's start, shifted to positive
+// definite where it is not (lagged Rayleigh damping, as in Li et al. 2020, IPC: a potential that is
+// never negative, and which damps a bent object's motion as K(x) does; the rest stiffness K(0)
+// damped large rotations several times too much, bench/README.md). grad Phi = 0 is the
+// integrator's own equation with C held through the step; its Hessian is w I + K(x) + J + s C.
+// Each step's predictor:
 //   Newmark:        qt = q + h v + h^2/4 a,  w = 4/h^2,  v0 = v + h/2 a,  s = 2/h
 //   backward Euler: qt = q + h v,            w = 1/h^2,  v0 = v,          s = 1/h
 // Newton on Phi, the Hessian shifted to positive definite where K(x) is not, backtracking on Phi
-// (Armijo), until |grad Phi| <= newton_tolerance x (|w (x - qt)| + |R + S'| + |f| + |C0 v|) or
+// (Armijo), until |grad Phi| <= newton_tolerance x (|w (x - qt)| + |R + S'| + |f| + |C v|) or
 // newton_iterations. Then the energy budget: with H = |v|^2/2 + E + S - f^T q at this step's loads,
 // a step may not end with more H than it began with, plus the slack earlier steps' discretisation
 // lost since the loads last changed (the trapezoidal rule trades energy back and forth on a
 // nonlinear model; without the slack the budget would damp it), less what damping dissipates. What the integrator would add beyond
 // it is taken out of the velocity (qv_step_report::energy_removed). So without loads and damping H
-// never exceeds its first value, and under bounded loads the state stays bounded.
+// never exceeds its first value, and under bounded loads the state stays bounded. Last, D for the
+// next step from K at the end.
 #include <cmath>
 
 #include "../instance.h"
@@ -28,7 +32,7 @@ struct StepPredictor {
   double h;  // the time step
 };
 
-// Phi's Hessian w I + K(x) + J + s C0, the matrix of each Newton direction (before any shift);
+// Phi's Hessian w I + K(x) + J + s C, the matrix of each Newton direction (before any shift);
 // fused explicitly, as newtonSystem() (dynamics.h).
 inline SystemScales minimizerSystem(const qv_instance& s, const StepPredictor& p) {
   return {1.0, 1.0, p.s * s.config.rayleigh_beta, std::fma(p.s, s.config.rayleigh_alpha, p.w)};

@@ -58,10 +58,11 @@ inline void newmarkNewtonScales(const qv_instance& s, double& c1, double& c2) {
 inline qv_step_status minimizedInstead(qv_instance& s, StepFunction minimizing) {
   s.lastStep = qv_step_report{};
   s.lastStep.minimized = 1;
-  // Its energy budget starts from this state, as after qv_instance_set_state: fixed Newton steps
-  // keep no account of E(q).
+  // Its energy budget and damping start from this state, as after qv_instance_set_state: fixed
+  // Newton steps keep no account of E(q) and D.
   s.elasticEnergyAtState = elasticEnergy(*s.model, s.config.elasticity, s.q, s.work.polynomialScratch);
   s.energySlack = 0;
+  s.dampingStiffnessAtState(s.dampingStiffness);
   return minimizing(s);
 }
 // The end of a fixed Newton step (s.end): taken, or, past max_displacement or not finite, the
