@@ -156,8 +156,8 @@ typedef enum qv_solver {
                              velocity). No bounded load can make it run away: it resets only on non-finite input.
                              Rayleigh damping C = alpha I + beta K(q) uses K at the step's start (lagged, shifted to
                              positive definite where compression made it indefinite), so it damps a bent object as
-                             the Newton iterations do. Costs about 3x a Newton step when one iteration converges
-                             (bench/README.md). */
+                             the Newton iterations do. Costs about 2x a fixed Newton step where one iteration
+                             converges, 3x where two do (bench/README.md). */
   QV_SOLVER_NEWTON = 1,   /* Barbic & James 2005: exactly newton_iterations Newton iterations on the equations of
                              motion, no line search, C = alpha I + beta K(q): the fastest while the strains stay
                              moderate. Where they do not (stiff springs, large twists, long time steps, sudden loads
