@@ -20,11 +20,16 @@ void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales&
 
 void dampWithStiffness(const qv_instance& s, const double* K, double* D) {
   const int r = s.r;
+  const double* K0 = s.model->restStiffness;
+  bool finite = true;
+  for (int i = 0; i < r * r; ++i) finite = finite && std::isfinite(K[i]);
+  if (!finite && K != K0) return dampWithStiffness(s, K0, D);  // the step resets anyway
   double largest = 0;
   for (int i = 0; i < r; ++i) largest = std::fmax(largest, std::fabs(K[i * r + i]));
+  if (!(largest > 0)) largest = 1;
   double* trial = s.work.system;  // free between steps, where D is set
-  double mu = 0;
   for (int rung = 0; rung <= 40; ++rung) {
+    const double mu = rung == 0 ? 0.0 : std::ldexp(1e-6 * largest, 2 * (rung - 1));
     for (int i = 0; i < r; ++i)
       for (int j = i; j < r; ++j) trial[i * r + j] = K[i * r + j] + (i == j ? mu : 0.0);
     if (choleskyFactor(trial, r)) {
@@ -32,10 +37,9 @@ void dampWithStiffness(const qv_instance& s, const double* K, double* D) {
       for (int i = 0; i < r; ++i) D[i * r + i] += mu;
       return;
     }
-    if (!(largest > 0) || !std::isfinite(largest)) break;
-    mu = rung > 0 ? 4 * mu : 1e-6 * largest;
   }
-  std::memcpy(D, s.model->restStiffness, sizeof(double) * r * r);
+  // Nothing finite is this far from definite; a positive definite D all the same.
+  for (int i = 0; i < r * r; ++i) D[i] = i % (r + 1) == 0 ? largest : 0.0;
 }
 
 QV_HOT void dampingForces(const qv_instance& s, const double* K, const double* v, double* out) {

@@ -31,9 +31,10 @@ inline SystemScales newtonSystem(const qv_instance& s, double c1, double c2) {
   return {std::fma(c1, s.config.rayleigh_beta, c2), c2, 0.0, std::fma(c1, s.config.rayleigh_alpha, 1.0)};
 }
 
-// D = K + mu I into `D` (may be K), K symmetric (r x r), mu the smallest of 0 and a ladder
-// from 1e-6 of K's largest diagonal entry, each rung 4x the last (40 at most), that makes D positive definite
-// (a negative damping would add energy); K(0) where none does (K not finite: the step resets).
+// D = K + mu I into `D` (may be K), K symmetric (r x r), mu the smallest of 0 and a ladder from
+// 1e-6 of K's largest diagonal entry, each rung 4x the last (40 at most), that makes D positive
+// definite (a negative damping would add energy). From K(0) where K is not finite (the step resets
+// anyway); always positive definite, so that a snapshot of it restores.
 void dampWithStiffness(const qv_instance& s, const double* K, double* D);
 
 // The matrix's upper triangle (all Cholesky reads) into s.work.system.

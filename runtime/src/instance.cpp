@@ -246,18 +246,21 @@ qv_step_status qv_instance::step() {
 void qv_instance::setState(const double* newQ, const double* newV, const double* newA) {
   if (newQ) std::memcpy(q, newQ, sizeof(double) * r);
   if (newV) std::memcpy(v, newV, sizeof(double) * r);
-  if (newA) {
-    std::memcpy(a, newA, sizeof(double) * r);
-  } else if (newQ || newV) {
-    // The acceleration the equations of motion give at the new state (persistent loads only), so
-    // that the next implicit step starts consistent rather than injecting energy.
-    quiver::rt::evaluateForces(*this, q);
-    quiver::rt::dampingForces(*this, v, work.damping);
-    for (int i = 0; i < r; ++i) a[i] = loads.gravityForce[i] - work.force[i] - work.damping[i];
-  }
+  const bool consistentA = !newA && (newQ || newV);
+  if (newQ || consistentA) quiver::rt::evaluateForces(*this, q);  // R(q) + S(q), K(q)
   if (newQ) {
     elasticEnergyAtState = quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
-    dampingStiffnessAtState(dampingStiffness);
+    quiver::rt::dampWithStiffness(*this, work.stiffness, dampingStiffness);
+  }
+  if (newA) {
+    std::memcpy(a, newA, sizeof(double) * r);
+  } else if (consistentA) {
+    // The acceleration the equations of motion give at the new state (persistent loads only), so
+    // that the next implicit step starts consistent rather than injecting energy; damped as the
+    // solver damps.
+    const bool lagged = config.solver == QV_SOLVER_MINIMIZE && config.integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES;
+    quiver::rt::dampingForces(*this, lagged ? dampingStiffness : work.stiffness, v, work.damping);
+    for (int i = 0; i < r; ++i) a[i] = loads.gravityForce[i] - work.force[i] - work.damping[i];
   }
   energySlack = 0;
 }
@@ -296,6 +299,9 @@ void qv_instance::saveSnapshot(double* out) const {
   }
   for (int i = 0; i < r; ++i)
     for (int j = i; j < r; ++j) *f++ = D[i * r + j];
+  // What the next step compares its loads with (Loads::changedSinceLastStep()).
+  std::memcpy(f, loads.lastStepForce, sizeof(double) * r);
+  f[r] = loads.changed ? 1.0 : 0.0;
 }
 
 bool qv_instance::restoreSnapshot(const double* in) {
@@ -307,6 +313,9 @@ bool qv_instance::restoreSnapshot(const double* in) {
   if (!quiver::rt::choleskyFactor(work.system, r)) return false;
   for (int i = 0, k = 0; i < r; ++i)
     for (int j = i; j < r; ++j, ++k) dampingStiffness[i * r + j] = dampingStiffness[j * r + i] = savedD[k];
+  const double* savedLoads = savedD + static_cast<size_t>(r) * (r + 1) / 2;
+  std::memcpy(loads.lastStepForce, savedLoads, sizeof(double) * r);
+  loads.changed = savedLoads[r] != 0;
   std::memcpy(q, in + 1, sizeof(double) * r);
   std::memcpy(v, in + 1 + r, sizeof(double) * r);
   std::memcpy(a, in + 1 + 2 * r, sizeof(double) * r);

@@ -122,10 +122,11 @@ struct qv_instance {
   qv_step_status endStep(qv_step_status status);  // the per-step loads are spent; a blown-up state resets
   // The snapshot: r, then q, v, a, E(q) and the energy slack, then in flight the frame (position,
   // orientation, velocity, angular momentum, last body omega), then D's upper triangle row by row,
-  // as doubles.
+  // then the last step's per-step forces and whether a persistent load changed since (1 or 0), as
+  // doubles: all a step reads beyond the caller's calls.
   size_t snapshotSize() const {
     const size_t n = static_cast<size_t>(r);
-    return sizeof(double) * (3 * n + 3 + (flying() ? 16 : 0) + n * (n + 1) / 2);
+    return sizeof(double) * (3 * n + 3 + (flying() ? 16 : 0) + n * (n + 1) / 2 + n + 1);
   }
   void saveSnapshot(double* out) const;
   bool restoreSnapshot(const double* in);

@@ -288,9 +288,10 @@ TEST(Step, DeterministicAndStateRoundTrips) {
   // Rewind b to step 100 and replay: the same bits again.
   EXPECT_EQ(qv_instance_restore_snapshot(b.s, saved.data(), saved.size() * sizeof(double) - 1), QV_ERROR_INVALID_ARGUMENT);
   // A damping stiffness that is not positive definite (it would add energy) is refused, and b is
-  // left as it was. The snapshot ends with its upper triangle; the last entry is D's (r, r).
+  // left as it was. D's upper triangle ends with its (r, r) entry, before the last step's r forces
+  // and the load-changed flag that end the snapshot.
   std::vector<double> spoiled = saved;
-  spoiled.back() = -1;
+  spoiled[spoiled.size() - r - 2] = -1;
   EXPECT_EQ(qv_instance_restore_snapshot(b.s, spoiled.data(), spoiled.size() * sizeof(double)), QV_ERROR_INVALID_ARGUMENT);
   qv_instance_get_state(b.s, sb.data(), sb.data() + r, sb.data() + 2 * r);
   EXPECT_EQ(0, std::memcmp(sa.data(), sb.data(), sizeof(double) * sa.size()));
@@ -301,6 +302,38 @@ TEST(Step, DeterministicAndStateRoundTrips) {
   }
   qv_instance_get_state(b.s, sb.data(), sb.data() + r, sb.data() + 2 * r);
   EXPECT_EQ(0, std::memcmp(sa.data(), sb.data(), sizeof(double) * sa.size()));
+}
+
+// The budget compares each step's loads with the last step's (a change forfeits the slack the
+// discretisation lost): the snapshot carries the last step's, so a rewound instance replays the
+// same bits whatever it was pushed by in between. Undamped and swinging far, where the slack is
+// won back.
+TEST(Step, ASnapshotCarriesTheLoadsTheBudgetComparesWith) {
+  test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  const int r = m.info.r, tip = m.tipVertex();
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  config.rayleigh_alpha = config.rayleigh_beta = 0;
+  Instance a(m.model, config), b(m.model, config);
+  const double push[3] = {0, 0, -20}, other[3] = {0, 5, 0};
+  for (int step = 0; step < 50; ++step)
+    for (auto* s : {a.s, b.s}) {
+      qv_instance_add_vertex_force(s, tip, push);
+      qv_instance_step(s);
+    }
+  std::vector<char> saved(qv_instance_snapshot_size(a.s));
+  qv_instance_save_snapshot(a.s, saved.data());
+  qv_instance_add_vertex_force(b.s, tip, other);
+  qv_instance_step(b.s);
+  ASSERT_EQ(qv_instance_restore_snapshot(b.s, saved.data(), saved.size()), QV_OK);
+  for (int step = 0; step < 100; ++step) {
+    for (auto* s : {a.s, b.s}) {
+      qv_instance_add_vertex_force(s, tip, push);
+      qv_instance_step(s);
+    }
+    ASSERT_EQ(state(a.s, r), state(b.s, r)) << "step " << step;
+  }
 }
 
 TEST(Step, DragSpringPullsAVertexToItsTarget) {

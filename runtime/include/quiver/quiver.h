@@ -292,11 +292,13 @@ QV_API void qv_instance_set_state(qv_instance* instance, const double* q, const 
                                   const double* acceleration);
 
 /* Everything that evolves (q, velocity, acceleration, the solver's energy budget and its damping
-   stiffness, r (r + 1) / 2 values) as an opaque block of qv_instance_snapshot_size() bytes, for
-   rewinding, replays and save games: restoring a snapshot and repeating the same calls repeats the
-   same bits. Restoring checks the size, that the snapshot came from a model of the same r and that
-   its damping stiffness is positive definite (QV_ERROR_INVALID_ARGUMENT otherwise, the instance
-   unchanged). */
+   stiffness, r (r + 1) / 2 values, and the last step's per-step forces, which the next step's
+   budget compares with) as an opaque block of qv_instance_snapshot_size() bytes, for rewinding,
+   replays and save games: restoring a snapshot and repeating the same calls repeats the same bits.
+   Restoring checks the size, that the snapshot came from a model of the same r and that its
+   damping stiffness is positive definite (QV_ERROR_INVALID_ARGUMENT otherwise, the instance
+   unchanged). Saving uses the instance's scratch (QV_SOLVER_NEWTON: it evaluates the state), so
+   save one instance from one thread at a time. */
 QV_API size_t qv_instance_snapshot_size(const qv_instance* instance);
 QV_API void qv_instance_save_snapshot(const qv_instance* instance, void* snapshot);
 QV_API qv_result qv_instance_restore_snapshot(qv_instance* instance, const void* snapshot, size_t size);
