@@ -19,6 +19,7 @@ struct Contact {
   double surfaceVelocity[3] = {};        // a kinematic collider's at the point
   double depth = 0;          // signed distance of the rigid shape's vertex (negative: penetrating)
   bool speculative = false;  // depth beyond the slop: not touching yet
+  int slot = 0;              // in a full list, of two equally poor the lower slot goes first (admit())
   double deformedDepth = 0;  // of the deformed vertex, reported
   double target = 0;         // the relative normal velocity the impulse aims at
   double bounce = 0;         // restitution x the approach speed: the target once the contact holds
@@ -48,8 +49,12 @@ struct ContactList {
   int pairCount = 0;
   int touching = 0;       // candidates within the slop this step, kept or not
   bool reducing = false;  // finding again, each pair down to its minLevel
+  bool full = false;      // contacts[0, count) is a heap with the one to give up first on top (admit())
 
-  void clear() { count = previousCount = 0; }
+  void clear() {
+    count = previousCount = 0;
+    full = false;
+  }
 };
 
 } // namespace quiver::rt

