@@ -15,6 +15,8 @@ import sys
 import tempfile
 import time
 
+from machine import machine_line
+
 LINE = re.compile(r"^quiver-bake: fidelity: .*\[([0-9.e+-]+) s\]$")
 
 
@@ -27,8 +29,7 @@ def main():
     bake = os.path.join(args.build, "apps", "quiver-bake")
     cases = [("vega_simpleBridge_tet.veg", 12827, ["--bou", os.path.join(args.meshes, "vega_simpleBridge_tet.bou")]),
              ("polyfem_cubes_v41.msh", 32981, ["--fix", "z<min+0.01", "--fidelity-max-tets", "40000"])]
-    cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
-    print(f"CPU: {cpu}\n")
+    print(f"{machine_line()}\n")
     print("| mesh | tets | fidelity stage (s) | whole bake, wall (s) |")
     print("|---|---:|---:|---:|")
     with tempfile.TemporaryDirectory() as tmp:

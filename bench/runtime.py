@@ -9,7 +9,6 @@ bake's OpenBLAS picks, and markdown tables (the ones in bench/README.md).
     /usr/bin/python3 bench/runtime.py --build build/release [--shared ../shared]
 """
 import argparse
-import ctypes
 import json
 import os
 import re
@@ -17,17 +16,9 @@ import statistics
 import subprocess
 import tempfile
 
+from machine import machine_line
+
 RANKS = (10, 20, 30, 40, 60)
-
-
-def blas_core():
-    """The kernel set Debian's OpenBLAS chose on this CPU (OPENBLAS_CORETYPE overrides it)."""
-    try:
-        lib = ctypes.CDLL("libopenblas.so.0")
-        lib.openblas_get_corename.restype = ctypes.c_char_p
-        return lib.openblas_get_corename().decode()
-    except OSError:
-        return "? (libopenblas.so.0 not found)"
 
 
 def vega_steps(shared, tmp, repetitions):
@@ -78,8 +69,7 @@ def main():
         return rows.get(name)
     peak = get("PeakFma")
     peak_gflops = peak["GFLOPS"] / 1e9 if peak else float("nan")
-    cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")), "?")
-    print(f"CPU: {cpu}; OpenBLAS core: {blas_core()}")
+    print(machine_line())
     print(f"Peak FMA throughput of this core, measured in the same run: {peak_gflops:.1f} GFLOP/s (double, its widest vectors)\n")
     print("| r | force (us) | force + stiffness (us) | Newmark step, fixed Newton (us) | its steps the minimiser took "
           "| Vega-like step, same run (us) | x Vega | Newmark step, minimise (us) | its Newton iterations "

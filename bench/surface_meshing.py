@@ -10,6 +10,8 @@ import re
 import subprocess
 import tempfile
 
+from machine import cpu_model
+
 
 def torus(path, major=1.0, minor=0.35, around=250, tube=100):
     """(around x tube x 2) = 50 000 outward triangles."""
@@ -33,9 +35,8 @@ def main():
     parser.add_argument("--build", default="build/release")
     parser.add_argument("--tets", type=int, default=20000)
     args = parser.parse_args()
-    cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")), "?")
     gmsh = subprocess.run(["gmsh", "--version"], capture_output=True, text=True)
-    print(f"CPU: {cpu}; gmsh {(gmsh.stdout + gmsh.stderr).strip()}, one thread")
+    print(f"CPU: {cpu_model()}; gmsh {(gmsh.stdout + gmsh.stderr).strip()}, one thread")
     with tempfile.TemporaryDirectory() as tmp:
         obj = os.path.join(tmp, "torus.obj")
         triangles = torus(obj)

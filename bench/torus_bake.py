@@ -23,6 +23,7 @@ import scipy.sparse
 import scipy.sparse.linalg
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from machine import machine_line  # noqa: E402
 from surface_meshing import torus  # noqa: E402
 
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_pml="ob1")
@@ -61,7 +62,6 @@ def main():
     ap.add_argument("--tets", type=int, default=98000)
     ap.add_argument("--repeat", type=int, default=2)
     args = ap.parse_args()
-    cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
     with tempfile.TemporaryDirectory() as tmp:
         obj = os.path.join(tmp, "torus.obj")
         torus(obj)
@@ -69,7 +69,7 @@ def main():
                         "--rank", "2", "--no-fidelity", "--quiet", "-o", os.path.join(tmp, "mesh")], check=True)
         mesh = os.path.join(tmp, "mesh.tets.vtu")
         tets = next(int(m.group(1)) for m in [re.search(r'NumberOfCells="(\d+)"', open(mesh, errors="ignore").read(4096))])
-        print(f"CPU: {cpu}; torus of {tets} tets (major radius 1 m, minor 0.35 m), fixed below its lowest 2 cm, "
+        print(f"{machine_line()}; torus of {tets} tets (major radius 1 m, minor 0.35 m), fixed below its lowest 2 cm, "
               "k = 20, r = 30\n")
         stage_names = ("mesh", "partition", "assemble", "modes", "derivatives", "basis", "polynomials", "export")
         print("| ranks | eigensolver | whole bake, wall (s) | " + " | ".join(stage_names) + " | BLAS |")

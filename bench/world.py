@@ -1,0 +1,49 @@
+#!/usr/bin/python3
+"""Worlds of free bodies in contact: N soft bars dropped in layers of four onto the ground and onto
+each other (`quiver sim --free --gravity --pile N`), one world step each frame on one thread, the
+median and 99th percentile of its wall time over 10 simulated seconds at 60 Hz. Bakes the bar
+(0.6 x 0.1 x 0.1 m, E = 1 MPa, no fixed vertex, 10 modes and their derivatives, r = 16) on 2 ranks.
+
+    /usr/bin/python3 bench/world.py --build build/release [--piles 20,80,320]
+"""
+import argparse
+import json
+import os
+import subprocess
+import tempfile
+
+from machine import machine_line
+
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_pml="ob1")
+STEPS = 600
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", default="build/release")
+    ap.add_argument("--piles", default="20,80,320")
+    args = ap.parse_args()
+    apps = os.path.join(args.build, "apps")
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        mesh, bar = os.path.join(tmp, "bar.vtu"), os.path.join(tmp, "bar")
+        subprocess.run([os.path.join(apps, "quiver-mesh"), "beam", "--size", "0.6,0.1,0.1", "--cells", "12,2,2",
+                        "-o", mesh], check=True, capture_output=True)
+        subprocess.run(["mpirun", "-n", "2", os.path.join(apps, "quiver-bake"), mesh, "--modes", "10", "--rank", "16",
+                        "--quiet", "-o", bar], check=True, env=ENV, stdin=subprocess.DEVNULL, capture_output=True)
+        for n in (int(x) for x in args.piles.split(",")):
+            out = subprocess.run([os.path.join(apps, "quiver"), "sim", bar + ".qvr", "--free", "--gravity", "--pile", str(n),
+                                  "--position", "0,0,0.2", "--collider", "plane:0,0,1,0", "--steps", str(STEPS), "--json"],
+                                 check=True, capture_output=True, text=True, stdin=subprocess.DEVNULL).stdout
+            rows.append((n, json.loads(out)))
+    print(machine_line() + f"; one thread, {STEPS} steps of 1/60 s\n")
+    print("| bodies | world step, median (ms) | 99th percentile (ms) | median per body (us) | fastest body at the end (m/s) "
+          "| deepest rigid-shape penetration (mm) | resets |")
+    print("|---:|---:|---:|---:|---:|---:|---:|")
+    for n, j in rows:
+        print(f"| {n} | {j['step_us_median'] / 1e3:.2f} | {j['step_us_p99'] / 1e3:.1f} | {j['step_us_median'] / n:.0f} "
+              f"| {j['max_final_speed_mps']:.1g} | {j['max_penetration_m'] * 1e3:.0f} | {j['resets']} |")
+
+
+if __name__ == "__main__":
+    main()
