@@ -219,7 +219,7 @@ Contact* admit(ContactList& list, ContactBody& b, int body, int other, int colli
     *slot = candidate;
   } else if (list.capacity) {
     // Full: the one to give up first is the top of a heap. A scan for it made every candidate past
-    // the capacity cost the whole list (a pile of 80 bars in a 4096-contact world: 120 ms frames).
+    // the capacity cost the whole list (a pile of 80 bars, 5120 contacts: 120 ms frames).
     if (!list.full) makeHeap(list.contacts, list.count);
     list.full = true;
     candidate.slot = list.contacts[0].slot;

@@ -297,8 +297,9 @@ QV_API void qv_instance_set_state(qv_instance* instance, const double* q, const 
    replays and save games: restoring a snapshot and repeating the same calls repeats the same bits.
    Restoring checks the size, that the snapshot came from a model of the same r and that its
    damping stiffness is positive definite (QV_ERROR_INVALID_ARGUMENT otherwise, the instance
-   unchanged). Saving uses the instance's scratch (QV_SOLVER_NEWTON: it evaluates the state), so
-   save one instance from one thread at a time. */
+   unchanged). Restoring also restores whether a persistent load had changed since that step, so
+   set loads after restoring, as the calls being repeated would. Saving uses the instance's scratch
+   (QV_SOLVER_NEWTON: it evaluates the state), so save one instance from one thread at a time. */
 QV_API size_t qv_instance_snapshot_size(const qv_instance* instance);
 QV_API void qv_instance_save_snapshot(const qv_instance* instance, void* snapshot);
 QV_API qv_result qv_instance_restore_snapshot(qv_instance* instance, const void* snapshot, size_t size);
