@@ -17,8 +17,9 @@ void elasticityAt(qv_instance& s, const double* q, double* energy, double* force
 const double* evaluateForces(qv_instance& s, const double* q);
 
 // C v = alpha v + beta K v into `out` (r values), K the elastic stiffness last evaluated (or, for
-// the minimising solver, its damping stiffness D): K is symmetric, so the product runs along its rows as axpys
-// (SIMD across i), each sum over j in order, instead of r chains of r dependent multiply-adds.
+// the minimising solver, its damping stiffness D): K is symmetric, so the product runs along its
+// rows as axpys (SIMD across i), each sum over j in order, instead of r chains of r dependent
+// multiply-adds.
 void dampingForces(const qv_instance& s, const double* K, const double* v, double* out);
 inline void dampingForces(const qv_instance& s, const double* v, double* out) {
   dampingForces(s, s.work.stiffness, v, out);

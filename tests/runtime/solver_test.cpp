@@ -39,7 +39,9 @@ TEST(Solver, AConvergedStepSolvesTheIntegratorsEquations) {
     qv_instance_config config;
     qv_instance_config_init(&config, m.model);
     config.integrator = integrator;
-    config.rayleigh_alpha = 2;  // K-proportional damping differs on purpose between the solvers (K at the step's start / at its end)
+    // K-proportional damping differs on purpose between the solvers (K at the step's start / at
+    // its end).
+    config.rayleigh_alpha = 2;
     config.rayleigh_beta = 0;
     config.newton_iterations = 40;
     config.newton_tolerance = 1e-10;

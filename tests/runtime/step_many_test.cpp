@@ -218,8 +218,9 @@ TEST(StepMany, StatesAgreeWithSteppingOneByOne) {
 TEST(StepMany, NewtonMatricesFactorisedInGroupsAgreeWithEachInstanceOwn) {
   // The group factorises the matrix each step solves with at each point it evaluates: the fixed
   // Newton step's I + c1 C + c2 (K + J) at the first guess (with a second iteration that must
-  // factorise its own at its own point), the minimiser's w I + K + J + s C at every iterate (C from each instance's own damping stiffness). Here
-  // with time steps, Rayleigh damping and held tips (J) that differ from lane to lane.
+  // factorise its own at its own point), the minimiser's w I + K + J + s C at every iterate (C
+  // from each instance's own damping stiffness). Here with time steps, Rayleigh damping and held
+  // tips (J) that differ from lane to lane.
   quiver::test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   const int count = 13, steps = 90;
