@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "formats/mesh/byte_cursor.h"
 #include "formats/mesh/read_mesh.h"
 #include "formats/mesh/write_mesh.h"
 #include "tests/formats/mesh/text_mesh_test_support.h"
@@ -169,7 +170,7 @@ struct BigEndianWriter {
   void put(T v) {
     char raw[sizeof(T)];
     std::memcpy(raw, &v, sizeof(T));
-    if (const uint16_t one = 1; *reinterpret_cast<const char*>(&one) == 1) std::reverse(raw, raw + sizeof(T));
+    if (hostIsLittleEndian()) std::reverse(raw, raw + sizeof(T));
     bytes.append(raw, sizeof(T));
   }
 };

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "formats/mesh/byte_cursor.h"
 #include "formats/mesh/read_mesh.h"
 #include "formats/mesh/write_mesh.h"
 #include "tests/formats/mesh/text_mesh_test_support.h"
@@ -168,9 +169,7 @@ private:
   void put(std::string& out, T v) const {
     char raw[sizeof(T)];
     std::memcpy(raw, &v, sizeof(T));
-    const uint16_t one = 1;
-    const bool hostLittle = *reinterpret_cast<const char*>(&one) == 1;
-    if (hostLittle == layout_.bigEndian) std::reverse(raw, raw + sizeof(T));
+    if (hostIsLittleEndian() == layout_.bigEndian) std::reverse(raw, raw + sizeof(T));
     out.append(raw, sizeof(T));
   }
 
@@ -357,8 +356,7 @@ TEST(VtuWrite, RoundTripIsBitExact) {
     displacement.values.emplace_back(normal(random), normal(random) * 1e-12, normal(random) * 1e12);
     velocity.values.emplace_back(v, -v, 0.5 * v);
   }
-  const uint16_t one = 1;
-  const std::string byteOrder = *reinterpret_cast<const char*>(&one) == 1 ? "LittleEndian" : "BigEndian";
+  const std::string byteOrder = hostIsLittleEndian() ? "LittleEndian" : "BigEndian";
   for (VtuEncoding encoding : {VtuEncoding::Ascii, VtuEncoding::AppendedRaw}) {
     SCOPED_TRACE(encoding == VtuEncoding::Ascii ? "ascii" : "appended raw");
     const std::string text = formatVtu(mesh, {displacement, velocity}, encoding);
