@@ -258,8 +258,7 @@ void qv_instance::setState(const double* newQ, const double* newV, const double*
     // The acceleration the equations of motion give at the new state (persistent loads only), so
     // that the next implicit step starts consistent rather than injecting energy; damped as the
     // solver damps.
-    const bool lagged = config.solver == QV_SOLVER_MINIMIZE && config.integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES;
-    quiver::rt::dampingForces(*this, lagged ? dampingStiffness : work.stiffness, v, work.damping);
+    quiver::rt::dampingForces(*this, minimizes() ? dampingStiffness : work.stiffness, v, work.damping);
     for (int i = 0; i < r; ++i) a[i] = loads.gravityForce[i] - work.force[i] - work.damping[i];
   }
   energySlack = 0;
@@ -277,7 +276,7 @@ void qv_instance::saveSnapshot(double* out) const {
   std::memcpy(out + 1 + 2 * r, a, sizeof(double) * r);
   // The minimiser's energy budget; other solvers keep no account of E(q), so theirs is written as a
   // minimising instance restored from it must start (a new budget from this state).
-  const bool budgeted = config.solver == QV_SOLVER_MINIMIZE && config.integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES;
+  const bool budgeted = minimizes();
   out[1 + 3 * r] = budgeted ? elasticEnergyAtState : quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
   out[2 + 3 * r] = budgeted ? energySlack : 0.0;
   double* f = out + 3 + 3 * r;

@@ -109,6 +109,10 @@ struct qv_instance {
   // leave it: for a state set from outside (setState(), a fixed Newton step the minimiser takes over).
   void dampingStiffnessAtState(double* D) const;
   bool flying() const { return config.free_flight != 0; }
+  // Its steps are the minimiser's, which keeps E(q), the energy slack and D from step to step.
+  bool minimizes() const {
+    return config.solver == QV_SOLVER_MINIMIZE && config.integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES;
+  }
   // A world force on a vertex: on q (and, in flight, on the frame).
   void addVertexForce(int vertex, const double force[3]);
   void setGravity(const double acceleration[3]);
