@@ -5,8 +5,9 @@
 // its frame (the model's surface mesh, triangle_mesh.h).
 //
 // Each step, between the frames' velocity updates and their moves (rigid_frame.h):
-// - every surface vertex within reach of a collider or another object (its signed distance below
-//   what the two can cover relative to each other in the step, a speculative margin) is a contact,
+// - every surface vertex within reach of a collider or another object (its signed distance below a
+//   speculative margin: twice what the two cover relative to each other in the step, or what the
+//   fastest body of its group covers, as the solve can stop or push either) is a contact,
 //   up to a capacity: when more are found, each pair (a body against a collider or another body)
 //   keeps its vertices down to a level (contact_points.h), a subset spread over its patch; the
 //   pairs with the most give up levels first;
@@ -34,6 +35,10 @@ struct ContactBody {
   double velocity[3] = {}, angularMomentum[3] = {};
   double omega[3] = {};  // the world angular velocity before the solve
   int firstPair = 0, pairEnd = 0;  // its pairs in the contact list
+  // Its group: the bodies it could touch in the step, and the ones those could touch; the fastest
+  // surface speed among them sets its speculative margins (spreadSpeeds(), contact.cpp).
+  int group = 0;
+  double ownSpeed = 0, groupSpeed = 0;
 };
 
 // Friction and restitution between two instances (a collider brings its own).
