@@ -40,7 +40,7 @@ def main():
             rows.append((n, json.loads(sim.stdout)))
     print(machine_line() + f"; one thread, {STEPS} steps of 1/60 s\n")
     print("| bodies | world step, median (ms) | 99th percentile (ms) | median per body (us) | fastest body at the end (m/s) "
-          "| deepest rigid-shape penetration (mm) | resets |")
+          "| deepest deformed-vertex penetration (mm) | resets |")
     print("|---:|---:|---:|---:|---:|---:|---:|")
     for n, j in rows:
         print(f"| {n} | {j['step_us_median'] / 1e3:.2f} | {j['step_us_p99'] / 1e3:.1f} | {j['step_us_median'] / n:.0f} "
