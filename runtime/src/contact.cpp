@@ -278,27 +278,40 @@ int groupOf(ContactBody* bodies, int i) {
   return i;
 }
 
-// Groups the bodies that could touch in the step (bounding spheres within what both cover), and
-// gives each the fastest surface speed in its group. Margins from a pair's relative speed at the
-// step's start miss what the solve does to either: a pile's layers fell together, the ground
-// stopped the lowest, and the next fell 5 cm into it; one hit from above pushed the one below it
-// into the ground.
-void spreadSpeeds(ContactBody* bodies, int count, double h) {
-  const double still[3] = {};
-  for (int i = 0; i < count; ++i) bodies[i].group = i, bodies[i].ownSpeed = relativeSpeed(bodies[i], still);
+// Groups the bodies that could touch in the step (bounding spheres within what the two cover
+// relative to each other), and gives each the fastest relative speed in its group, of two of its
+// bodies or of one and a collider within reach. Margins from a pair's relative speed at the step's
+// start miss what the solve does to either: a pile's layers fell together, the ground stopped the
+// lowest, and the next fell 5 cm into it; one hit from above pushed the one below it into the
+// ground. Bodies that touch nothing moving otherwise (a pile falling together) keep their margins.
+void spreadSpeeds(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h) {
+  for (int i = 0; i < count; ++i) {
+    ContactBody& b = bodies[i];
+    const qv_instance& s = *b.instance;
+    b.group = i, b.touchSpeed = 0;
+    for (int k = 0; k < colliderCount; ++k) {
+      double u[3], distance, normal[3];
+      surfaceVelocity(colliders[k], s.frame.position, u);
+      const double speed = relativeSpeed(b, u), reach = s.surfaceRadius + s.contactSlop + 2 * h * speed;
+      if (colliderDistance(colliders[k], s.frame.position, reach, distance, normal) && distance <= reach)
+        b.touchSpeed = std::fmax(b.touchSpeed, speed);
+    }
+  }
   for (int i = 0; i < count; ++i)
     for (int j = i + 1; j < count; ++j) {
       const qv_instance &a = *bodies[i].instance, &b = *bodies[j].instance;
+      const double speed = relativeSpeed(bodies[i], bodies[j].velocity) + norm3(bodies[j].omega) * b.surfaceRadius;
       double gap[3];
       for (int k = 0; k < 3; ++k) gap[k] = a.frame.position[k] - b.frame.position[k];
-      const double reach = a.surfaceRadius + b.surfaceRadius + std::fmax(a.contactSlop, b.contactSlop) +
-                           2 * h * (bodies[i].ownSpeed + bodies[j].ownSpeed);
-      if (norm3(gap) <= reach) bodies[groupOf(bodies, i)].group = groupOf(bodies, j);
+      if (norm3(gap) > a.surfaceRadius + b.surfaceRadius + std::fmax(a.contactSlop, b.contactSlop) + 2 * h * speed) continue;
+      bodies[i].touchSpeed = std::fmax(bodies[i].touchSpeed, speed);
+      bodies[j].touchSpeed = std::fmax(bodies[j].touchSpeed, speed);
+      bodies[groupOf(bodies, i)].group = groupOf(bodies, j);
     }
   for (int i = 0; i < count; ++i) bodies[i].groupSpeed = 0;
   for (int i = 0; i < count; ++i) {
     ContactBody& root = bodies[groupOf(bodies, i)];
-    root.groupSpeed = std::fmax(root.groupSpeed, bodies[i].ownSpeed);
+    root.groupSpeed = std::fmax(root.groupSpeed, bodies[i].touchSpeed);
   }
   for (int i = 0; i < count; ++i) bodies[i].groupSpeed = bodies[groupOf(bodies, i)].groupSpeed;
 }
@@ -437,7 +450,7 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     std::memcpy(b.angularMomentum, f.angularMomentum, sizeof b.angularMomentum);
     f.worldOmega(b.omega);
   }
-  spreadSpeeds(bodies, bodyCount, h);
+  spreadSpeeds(bodies, bodyCount, colliders, colliderCount, h);
   // Contacts: each surface vertex of the rest shape carried by the frame. Found and solved on the
   // rigid shape: the deformation takes the forces but does not move the contacts (taking its
   // vertices made the loads on q and the contacts chase each other: a resting bar fluttered, bent

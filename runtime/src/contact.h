@@ -7,7 +7,7 @@
 // Each step, between the frames' velocity updates and their moves (rigid_frame.h):
 // - every surface vertex within reach of a collider or another object (its signed distance below a
 //   speculative margin: twice what the two cover relative to each other in the step, or what the
-//   fastest body of its group covers, as the solve can stop or push either) is a contact,
+//   fastest relative motion in its group covers, as the solve can stop or push either) is a contact,
 //   up to a capacity: when more are found, each pair (a body against a collider or another body)
 //   keeps its vertices down to a level (contact_points.h), a subset spread over its patch; the
 //   pairs with the most give up levels first;
@@ -35,10 +35,11 @@ struct ContactBody {
   double velocity[3] = {}, angularMomentum[3] = {};
   double omega[3] = {};  // the world angular velocity before the solve
   int firstPair = 0, pairEnd = 0;  // its pairs in the contact list
-  // Its group: the bodies it could touch in the step, and the ones those could touch; the fastest
-  // surface speed among them sets its speculative margins (spreadSpeeds(), contact.cpp).
+  // Its group: the bodies it could touch in the step, and the ones those could touch. The fastest
+  // relative speed of one of them against what it could touch sets its speculative margins
+  // (spreadSpeeds(), contact.cpp).
   int group = 0;
-  double ownSpeed = 0, groupSpeed = 0;
+  double touchSpeed = 0, groupSpeed = 0;
 };
 
 // Friction and restitution between two instances (a collider brings its own).
