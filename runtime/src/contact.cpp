@@ -316,6 +316,15 @@ void spreadSpeeds(ContactBody* bodies, int count, const qv_collider* colliders, 
   for (int i = 0; i < count; ++i) bodies[i].groupSpeed = bodies[groupOf(bodies, i)].groupSpeed;
 }
 
+// How far from a surface a candidate can be and still be kept: a full list takes only those its
+// poorest would give way to (admit()), so the closest-point queries need not look farther (in a
+// pile of 320 bars they took half the step). Touching candidates are always found: they are counted.
+double keptReach(const ContactList& list, double margin, double slop) {
+  if (!list.full) return margin;
+  const Contact& poorest = list.contacts[0];
+  return std::fmin(margin, poorest.speculative ? poorest.depth : slop);
+}
+
 // Each surface vertex of body i against every collider.
 void findColliderContacts(ContactBody* bodies, int i, const qv_collider* colliders, int count, double h,
                           ContactList& list) {
@@ -328,7 +337,8 @@ void findColliderContacts(ContactBody* bodies, int i, const qv_collider* collide
       const qv_collider& col = colliders[k];
       double u[3], depth, normal[3];
       surfaceVelocity(col, p, u);
-      const double margin = s.contactSlop + 2 * h * std::fmax(relativeSpeed(bodies[i], u), bodies[i].groupSpeed);
+      const double margin = keptReach(list, s.contactSlop + 2 * h * std::fmax(relativeSpeed(bodies[i], u), bodies[i].groupSpeed),
+                                      s.contactSlop);
       if (!colliderDistance(col, p, margin, depth, normal) || depth > margin) continue;
       Contact* ct = admit(list, bodies[i], i, -1, k, n, depth);
       if (!ct) continue;
@@ -360,7 +370,8 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
     double p[3], depth, normal[3];
     int otherVertex = 0;
     worldVertex(a, v, false, p);
-    if (!bodyDistance(b, p, margin, depth, normal, &otherVertex) || depth > margin) continue;
+    const double reach = keptReach(list, margin, a.contactSlop);
+    if (!bodyDistance(b, p, reach, depth, normal, &otherVertex) || depth > reach) continue;
     Contact* ct = admit(list, bodies[i], i, j, -1, n, depth);
     if (!ct) continue;
     ct->otherVertex = otherVertex;
