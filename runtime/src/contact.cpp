@@ -128,15 +128,18 @@ void worldVertex(const qv_instance& s, int v, bool deformed, double out[3]) {
 }
 
 // Signed distance of world point p to a body's rest surface carried by its frame; the surface
-// vertex nearest the closest point through `vertex`. False when beyond `reach`.
-bool bodyDistance(const qv_instance& s, const double p[3], double reach, double& distance, double normal[3], int* vertex) {
+// vertex nearest the closest point through `vertex`. False when beyond `reach`. With `facing` (a
+// world direction), to the surface facing against it only (qv_triangle_mesh::distance).
+bool bodyDistance(const qv_instance& s, const double p[3], double reach, double& distance, double normal[3], int* vertex,
+                  const double* facing = nullptr) {
   const qv_model& m = *s.model;
-  double rel[3], local[3], n[3];
+  double rel[3], local[3], n[3], localFacing[3];
   for (int a = 0; a < 3; ++a) rel[a] = p[a] - s.frame.position[a];
   s.frame.toBody(rel, local);
   for (int a = 0; a < 3; ++a) local[a] += m.rigidBody[a];  // the mesh is in the model's rest coordinates
+  if (facing) s.frame.toBody(facing, localFacing);
   int triangle = 0;
-  if (!m.surfaceMesh->distance(local, reach, distance, n, &triangle)) return false;
+  if (!m.surfaceMesh->distance(local, reach, distance, n, &triangle, facing ? localFacing : nullptr)) return false;
   s.frame.toWorldDirection(n, normal);
   if (vertex) {
     double best = INFINITY;
@@ -372,6 +375,15 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
     worldVertex(a, v, false, p);
     const double reach = keptReach(list, margin, a.contactSlop);
     if (!bodyDistance(b, p, reach, depth, normal, &otherVertex) || depth > reach) continue;
+    // A touching vertex facing the same way as the surface it is nearest lies along it and cannot
+    // press on it: it presses on the nearest part of the surface that faces it. (Bars laid edge on
+    // edge had each rim vertex nearest the side face under the other's rim: its sideways normals
+    // rolled them over, 13-23 degrees, and they rested so, sunk into each other.)
+    double own[3];
+    if (depth <= a.contactSlop && a.model->surfaceMesh) {
+      a.frame.toWorldDirection(a.model->surfaceMesh->vertexNormals + 3 * v, own);
+      if (dot3(own, normal) > 0 && !bodyDistance(b, p, reach, depth, normal, &otherVertex, own)) continue;
+    }
     Contact* ct = admit(list, bodies[i], i, j, -1, n, depth);
     if (!ct) continue;
     ct->otherVertex = otherVertex;

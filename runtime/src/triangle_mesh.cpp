@@ -274,7 +274,8 @@ void destroyTriangleMesh(qv_triangle_mesh* mesh) {
 
 } // namespace quiver::rt
 
-bool qv_triangle_mesh::distance(const double p[3], double reach, double& signedDistance, double normal[3], int* triangle) const {
+bool qv_triangle_mesh::distance(const double p[3], double reach, double& signedDistance, double normal[3], int* triangle,
+                                const double* facing) const {
   using namespace quiver::rt;
   if (boxDistance2(nodes[0], p) > reach * reach) return false;
   // Nearest first: the nearer child is searched first, and a box farther than the best so far is skipped.
@@ -288,6 +289,7 @@ bool qv_triangle_mesh::distance(const double p[3], double reach, double& signedD
     if (node.count) {
       for (int i = node.first; i < node.first + node.count; ++i) {
         const int t = order[i];
+        if (facing && dot3(faceNormals + 3 * t, facing) >= 0) continue;
         const int* tri = triangles + 3 * t;
         double c[3];
         const int feature = closestOnTriangle(p, vertices + 3 * tri[0], vertices + 3 * tri[1], vertices + 3 * tri[2], c);
@@ -301,6 +303,15 @@ bool qv_triangle_mesh::distance(const double p[3], double reach, double& signedD
     stack[depth++] = near == node.first ? node.first + 1 : node.first;
     stack[depth++] = near;
   }
+  if (triangle) *triangle = bestTriangle;
+  if (facing) {
+    if (best == INFINITY) return false;
+    const double* face = faceNormals + 3 * bestTriangle;
+    const double d[3] = {p[0] - closest[0], p[1] - closest[1], p[2] - closest[2]};
+    signedDistance = dot3(d, face) < 0 ? -std::sqrt(best) : std::sqrt(best);
+    std::memcpy(normal, face, 3 * sizeof(double));
+    return true;
+  }
   const double* pseudo = bestFeature == 6 ? faceNormals + 3 * bestTriangle
                          : bestFeature >= 3 ? edgeNormals + 3 * (3 * bestTriangle + bestFeature - 3)
                                             : vertexNormals + 3 * triangles[3 * bestTriangle + bestFeature];
@@ -309,6 +320,5 @@ bool qv_triangle_mesh::distance(const double p[3], double reach, double& signedD
   const double sign = dot3(d, pseudo) < 0 ? -1.0 : 1.0;
   signedDistance = sign * length;
   for (int a = 0; a < 3; ++a) normal[a] = length > 1e-12 ? sign * d[a] / length : pseudo[a];
-  if (triangle) *triangle = bestTriangle;
   return true;
 }

@@ -32,8 +32,11 @@ struct qv_triangle_mesh {
   // Signed distance of `p` (negative inside) and the outward unit normal there: the direction
   // from the closest surface point to p outside, from p to it inside. False when p is farther
   // than `reach` outside the mesh's bounding box (nothing computed). `triangle`, when not null,
-  // receives the closest triangle.
-  bool distance(const double p[3], double reach, double& distance, double normal[3], int* triangle = nullptr) const;
+  // receives the closest triangle. With `facing` (a unit direction), only the triangles facing
+  // against it count: the distance to the nearest of them, negative on the inner side of its plane,
+  // and its normal (false when there is none).
+  bool distance(const double p[3], double reach, double& distance, double normal[3], int* triangle = nullptr,
+                const double* facing = nullptr) const;
 };
 
 namespace quiver::rt {

@@ -1,9 +1,11 @@
 // qv_triangle_mesh's signed distance against geometry it does not share code with: a cube mesh
-// against the box's closed form, a fine sphere against |p| - R, a non-convex star's sign against
-// the winding number (solid angles), its distance against the nearest of many surface samples;
+// against the box's closed form (and, facing down, against its top face's), a fine sphere against
+// |p| - R, a non-convex star's sign against the winding number (solid angles), its distance against
+// the nearest of many surface samples;
 // bad meshes refused with what and where.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -110,6 +112,27 @@ TEST(TriangleMesh, ACubeMeasuresAsTheBoxDoes) {
   EXPECT_TRUE(m.mesh->distance(far, 8.5, d, n));
   EXPECT_DOUBLE_EQ(d, 8);
   EXPECT_EQ(n[2], 1);
+}
+
+// Facing down (a vertex on the underside of something above), only the top face counts: the
+// distance to the nearest point of its rectangle, negative below its plane, and its normal.
+TEST(TriangleMesh, FacingADirectionOnlyTheFacesAgainstItCount) {
+  const double half[3] = {0.5, 1, 2}, down[3] = {0, 0, -1};
+  Mesh m(cube(half));
+  ASSERT_EQ(m.result, QV_OK) << m.message;
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-3, 3);
+  for (int i = 0; i < 2000; ++i) {
+    const double p[3] = {u(rng), u(rng), u(rng)};
+    const double cx = std::clamp(p[0], -half[0], half[0]), cy = std::clamp(p[1], -half[1], half[1]);
+    const double length = std::sqrt((p[0] - cx) * (p[0] - cx) + (p[1] - cy) * (p[1] - cy) + (p[2] - half[2]) * (p[2] - half[2]));
+    double d, n[3];
+    ASSERT_TRUE(m.mesh->distance(p, INFINITY, d, n, nullptr, down));
+    ASSERT_NEAR(d, p[2] < half[2] ? -length : length, 1e-12) << p[0] << " " << p[1] << " " << p[2];
+    EXPECT_EQ(n[0], 0);
+    EXPECT_EQ(n[1], 0);
+    EXPECT_EQ(n[2], 1);
+  }
 }
 
 TEST(TriangleMesh, AFineSphereMeasuresAsTheSphereDoes) {
