@@ -281,21 +281,24 @@ int groupOf(ContactBody* bodies, int i) {
   return i;
 }
 
-// Groups the bodies that could touch in the step (bounding spheres within what the two cover
-// relative to each other), and gives each the fastest relative speed in its group, of two of its
-// bodies or of one and a collider within reach. Margins from a pair's relative speed at the step's
-// start miss what the solve does to either: a pile's layers fell together, the ground stopped the
-// lowest, and the next fell 5 cm into it; one hit from above pushed the one below it into the
-// ground. Bodies that touch nothing moving otherwise (a pile falling together) keep their margins.
+// Groups the bodies that could touch in the step (bounding spheres within what both cover, either
+// stopped), and gives each the fastest relative speed in its group, of two of its bodies or of one
+// and a collider within reach. Margins from a pair's relative speed at the step's start miss what
+// the solve does to either: a pile's layers fell together, the ground stopped the lowest, and the
+// next fell 5 cm into it; one hit from above pushed the one below it into the ground. A group that
+// touches nothing moving otherwise (a pile falling together) keeps its margins.
 void spreadSpeeds(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h) {
+  const double still[3] = {};
   for (int i = 0; i < count; ++i) {
     ContactBody& b = bodies[i];
     const qv_instance& s = *b.instance;
-    b.group = i, b.touchSpeed = 0;
+    b.group = i, b.touchSpeed = 0, b.ownSpeed = relativeSpeed(b, still);
     for (int k = 0; k < colliderCount; ++k) {
       double u[3], distance, normal[3];
       surfaceVelocity(colliders[k], s.frame.position, u);
-      const double speed = relativeSpeed(b, u), reach = s.surfaceRadius + s.contactSlop + 2 * h * speed;
+      // The collider's spin moves its surface within reach faster than at the body's centre.
+      const double speed = relativeSpeed(b, u) + norm3(colliders[k].angular_velocity) * s.surfaceRadius;
+      const double reach = s.surfaceRadius + s.contactSlop + 2 * h * speed;
       if (colliderDistance(colliders[k], s.frame.position, reach, distance, normal) && distance <= reach)
         b.touchSpeed = std::fmax(b.touchSpeed, speed);
     }
@@ -303,10 +306,13 @@ void spreadSpeeds(ContactBody* bodies, int count, const qv_collider* colliders, 
   for (int i = 0; i < count; ++i)
     for (int j = i + 1; j < count; ++j) {
       const qv_instance &a = *bodies[i].instance, &b = *bodies[j].instance;
-      const double speed = relativeSpeed(bodies[i], bodies[j].velocity) + norm3(bodies[j].omega) * b.surfaceRadius;
       double gap[3];
       for (int k = 0; k < 3; ++k) gap[k] = a.frame.position[k] - b.frame.position[k];
-      if (norm3(gap) > a.surfaceRadius + b.surfaceRadius + std::fmax(a.contactSlop, b.contactSlop) + 2 * h * speed) continue;
+      // Within reach if either stopped (their relative speed is never more than both speeds).
+      if (norm3(gap) > a.surfaceRadius + b.surfaceRadius + std::fmax(a.contactSlop, b.contactSlop) +
+                           2 * h * (bodies[i].ownSpeed + bodies[j].ownSpeed))
+        continue;
+      const double speed = relativeSpeed(bodies[i], bodies[j].velocity) + norm3(bodies[j].omega) * b.surfaceRadius;
       bodies[i].touchSpeed = std::fmax(bodies[i].touchSpeed, speed);
       bodies[j].touchSpeed = std::fmax(bodies[j].touchSpeed, speed);
       bodies[groupOf(bodies, i)].group = groupOf(bodies, j);
@@ -321,11 +327,12 @@ void spreadSpeeds(ContactBody* bodies, int count, const qv_collider* colliders, 
 
 // How far from a surface a candidate can be and still be kept: a full list takes only those its
 // poorest would give way to (admit()), so the closest-point queries need not look farther (in a
-// pile of 320 bars they took half the step). Touching candidates are always found: they are counted.
+// pile of 320 bars they took half the step). Touching candidates (within the vertex's own slop,
+// which differs from model to model) are always found: they are counted.
 double keptReach(const ContactList& list, double margin, double slop) {
   if (!list.full) return margin;
   const Contact& poorest = list.contacts[0];
-  return std::fmin(margin, poorest.speculative ? poorest.depth : slop);
+  return std::fmin(margin, poorest.speculative ? std::fmax(poorest.depth, slop) : slop);
 }
 
 // Each surface vertex of body i against every collider.
@@ -378,11 +385,21 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
     // A touching vertex facing the same way as the surface it is nearest lies along it and cannot
     // press on it: it presses on the nearest part of the surface that faces it. (Bars laid edge on
     // edge had each rim vertex nearest the side face under the other's rim: its sideways normals
-    // rolled them over, 13-23 degrees, and they rested so, sunk into each other.)
+    // rolled them over, 13-23 degrees, and they rested so, sunk into each other.) Unless that part
+    // is deeper than a touching contact sinks (a resting one: 3 slops and 2 g h^2, the soft
+    // contacts' most, solveContacts()) beyond the reach: then it is some other part of the body.
     double own[3];
+    const double* facing = nullptr;
     if (depth <= a.contactSlop && a.model->surfaceMesh) {
       a.frame.toWorldDirection(a.model->surfaceMesh->vertexNormals + 3 * v, own);
-      if (dot3(own, normal) > 0 && !bodyDistance(b, p, reach, depth, normal, &otherVertex, own)) continue;
+      double facingDepth, facingNormal[3];
+      int facingVertex = 0;
+      const double deepest = reach + 3 * a.contactSlop + 2 * norm3(a.frame.gravity) * h * h;
+      if (dot3(own, normal) > 0 && bodyDistance(b, p, reach, facingDepth, facingNormal, &facingVertex, own) &&
+          std::fabs(facingDepth) <= deepest) {
+        facing = own, depth = facingDepth, otherVertex = facingVertex;
+        std::memcpy(normal, facingNormal, sizeof facingNormal);
+      }
     }
     Contact* ct = admit(list, bodies[i], i, j, -1, n, depth);
     if (!ct) continue;
@@ -392,7 +409,7 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
     // vertex moved along the normal (both deform).
     double deformed[3], ignored[3], u[3], uWorld[3];
     worldVertex(a, v, true, deformed);
-    bodyDistance(b, deformed, INFINITY, ct->deformedDepth, ignored, nullptr);
+    bodyDistance(b, deformed, INFINITY, ct->deformedDepth, ignored, nullptr, facing);
     b.model->vertexLinear(otherVertex, b.q, u, nullptr);
     b.frame.toWorldDirection(u, uWorld);
     ct->deformedDepth -= dot3(uWorld, normal);

@@ -35,11 +35,11 @@ struct ContactBody {
   double velocity[3] = {}, angularMomentum[3] = {};
   double omega[3] = {};  // the world angular velocity before the solve
   int firstPair = 0, pairEnd = 0;  // its pairs in the contact list
-  // Its group: the bodies it could touch in the step, and the ones those could touch. The fastest
-  // relative speed of one of them against what it could touch sets its speculative margins
-  // (spreadSpeeds(), contact.cpp).
+  // Its group: the bodies it could touch in the step (either stopped), and the ones those could
+  // touch. The fastest relative speed of one of them against what it could touch sets its
+  // speculative margins (spreadSpeeds(), contact.cpp). ownSpeed: its surface's, in the world.
   int group = 0;
-  double touchSpeed = 0, groupSpeed = 0;
+  double ownSpeed = 0, touchSpeed = 0, groupSpeed = 0;
 };
 
 // Friction and restitution between two instances (a collider brings its own).

@@ -88,24 +88,25 @@ TEST(World, InAStackTheGroundCarriesBothAndTheLowerBarTheUpper) {
   EXPECT_NEAR(upper.position[2], 0.15, 6e-3);
 }
 
-// Three bars one above the other, `gap` apart, dropped from `drop` (their centres and rolls).
+// Three bars one above the other, `gap` apart, dropped from `drop`.
 struct ThreeBars {
   double landing = 0, deepest = 0, tilt = 0;  // m/s; the rigid shapes' overlap, m; the most tilted at the end, rad
 };
+enum class Laid { Crosswise, EdgeOnEdge };
 
-// Turned by k quarter turns about z (crosswise) or not (edge above edge). The overlap is of the
-// rigid shapes the frames carry: crosswise they touch about their centres and laid edge on edge
-// along their whole faces, so it is the bar's thickness less the distance of the centres while
-// they stay level; the tilt at the end says whether they do.
-ThreeBars dropThreeBars(bool crosswise, double gap, double drop) {
+// Crosswise (each turned a quarter about z from the one below) or edge on edge (aligned). The
+// overlap is of the rigid shapes the frames carry: crosswise they touch about their centres, edge
+// on edge along their whole faces, so it is the bars' height less the distance of the centres
+// while they stay level; the tilt at the end says whether they do.
+ThreeBars dropThreeBars(Laid laid, double gap, double drop) {
   FreeBar bar(16, {12, 2, 2});
-  const double h = 1.0 / 60, thickness = 0.1;
+  const double h = 1.0 / 60, height = 0.1;
   World world;
   world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0)};
   world.setColliders();
   for (int k = 0; k < 3; ++k) {
-    qv_rigid_state s = at(0.3, 0.05, drop + thickness / 2 + k * (thickness + gap));
-    if (crosswise) s.orientation[0] = std::cos(k * M_PI / 4), s.orientation[3] = std::sin(k * M_PI / 4);
+    qv_rigid_state s = at(0.3, 0.05, drop + height / 2 + k * (height + gap));
+    if (laid == Laid::Crosswise) s.orientation[0] = std::cos(k * M_PI / 4), s.orientation[3] = std::sin(k * M_PI / 4);
     world.add(bar, h, s, true);
   }
   ThreeBars out;
@@ -118,8 +119,8 @@ ThreeBars dropThreeBars(bool crosswise, double gap, double drop) {
       const Eigen::Quaterniond turn(s[k].orientation[0], s[k].orientation[1], s[k].orientation[2], s[k].orientation[3]);
       if (i == 119) out.tilt = std::max(out.tilt, std::acos(std::min(1.0, (turn * Eigen::Vector3d::UnitZ()).z())));
     }
-    out.deepest = std::max({out.deepest, thickness / 2 - s[0].position[2], thickness - (s[1].position[2] - s[0].position[2]),
-                            thickness - (s[2].position[2] - s[1].position[2])});
+    out.deepest = std::max({out.deepest, height / 2 - s[0].position[2], height - (s[1].position[2] - s[0].position[2]),
+                            height - (s[2].position[2] - s[1].position[2])});
   }
   return out;
 }
@@ -129,7 +130,7 @@ ThreeBars dropThreeBars(bool crosswise, double gap, double drop) {
 // and each fell into the one stopped below it (24.6 mm, measured).
 TEST(World, BarsFallingTogetherDoNotFallIntoEachOtherWhenTheLowestLands) {
   const double h = 1.0 / 60, gap = 0.03;
-  const ThreeBars three = dropThreeBars(true, gap, 0.8);
+  const ThreeBars three = dropThreeBars(Laid::Crosswise, gap, 0.8);
   std::printf("three bars crosswise falling 3 cm apart, landing at %.2f m/s: deepest overlap of their rigid shapes %.2f mm\n",
               three.landing, 1e3 * three.deepest);
   EXPECT_GT(three.landing * h, gap + 0.03);  // each step covers the gap, and more
@@ -141,7 +142,7 @@ TEST(World, BarsFallingTogetherDoNotFallIntoEachOtherWhenTheLowestLands) {
 // into each other (measured), dropped from 5 mm as from 0.8 m.
 TEST(World, BarsLaidEdgeOnEdgeStayLevel) {
   for (const double drop : {0.0, 0.8}) {
-    const ThreeBars three = dropThreeBars(false, 0.005, drop);
+    const ThreeBars three = dropThreeBars(Laid::EdgeOnEdge, 0.005, drop);
     std::printf("three bars edge on edge, landing at %.2f m/s: tilted %.3f degrees at the end, deepest overlap %.2f mm\n",
                 three.landing, three.tilt * 180 / M_PI, 1e3 * three.deepest);
     EXPECT_LT(three.tilt, 0.5 * M_PI / 180);
