@@ -87,6 +87,26 @@ double boxDistance(const double p[3], const double e[3], double normal[3]) {
   return inside;
 }
 
+// The same, counting only the faces facing against `facing`: the distance to the nearest of them
+// (its rectangle), negative on the inner side of its plane, and its normal; false when none does.
+bool boxFacingDistance(const double p[3], const double e[3], const double facing[3], double& distance, double normal[3]) {
+  double best = INFINITY;
+  for (int axis = 0; axis < 3; ++axis)
+    for (const double side : {-1.0, 1.0}) {
+      if (side * facing[axis] >= 0) continue;
+      double d2 = 0;
+      for (int a = 0; a < 3; ++a) {
+        const double along = a == axis ? p[a] - side * e[a] : std::fabs(p[a]) - e[a];
+        if (a == axis || along > 0) d2 += along * along;
+      }
+      if (d2 >= best) continue;
+      best = d2;
+      distance = side * (p[axis] - side * e[axis]) < 0 ? -std::sqrt(d2) : std::sqrt(d2);
+      for (int a = 0; a < 3; ++a) normal[a] = a == axis ? side : 0;
+    }
+  return best < INFINITY;
+}
+
 // 1 / (1/m + n . ((I^-1 (a x n)) x a)): the mass the impulse along n at arm a meets on one body.
 double inverseMass(const ContactBody& b, const double a[3], const double n[3]) {
   double an[3], ian[3], back[3];
@@ -335,6 +355,27 @@ double keptReach(const ContactList& list, double margin, double slop) {
   return std::fmin(margin, poorest.speculative ? std::fmax(poorest.depth, slop) : slop);
 }
 
+// A touching vertex facing the same way as the surface it is nearest lies along it and cannot press
+// on it: it presses on the nearest part of the surface that faces it, which `query(depth, normal)`
+// measures against its outward pseudo-normal `own` (filled in here). Bars laid edge on edge had
+// each rim vertex nearest the side face under the other's rim, and a bar laid flush with a box's
+// edge each vertex of its side: those sideways normals rolled the stacked bars over, 13-23
+// degrees, and the bar off the box. Not where that part is deeper than a touching contact sinks
+// (3 slops and 2 g h^2, the soft contacts' most at rest, solveContacts()) beyond the reach: that
+// is some other part of the surface. Returns whether it took that part's depth and normal.
+template <class Query>
+bool pressFacing(const qv_instance& s, int v, double reach, double h, double& depth, double normal[3], double own[3],
+                 Query query) {
+  if (depth > s.contactSlop || !s.model->surfaceMesh) return false;
+  s.frame.toWorldDirection(s.model->surfaceMesh->vertexNormals + 3 * v, own);
+  double facingDepth, facingNormal[3];
+  const double deepest = reach + 3 * s.contactSlop + 2 * norm3(s.frame.gravity) * h * h;
+  if (dot3(own, normal) <= 0 || !query(facingDepth, facingNormal) || std::fabs(facingDepth) > deepest) return false;
+  depth = facingDepth;
+  std::memcpy(normal, facingNormal, sizeof facingNormal);
+  return true;
+}
+
 // Each surface vertex of body i against every collider.
 void findColliderContacts(ContactBody* bodies, int i, const qv_collider* colliders, int count, double h,
                           ContactList& list) {
@@ -350,12 +391,16 @@ void findColliderContacts(ContactBody* bodies, int i, const qv_collider* collide
       const double margin = keptReach(list, s.contactSlop + 2 * h * std::fmax(relativeSpeed(bodies[i], u), bodies[i].groupSpeed),
                                       s.contactSlop);
       if (!colliderDistance(col, p, margin, depth, normal) || depth > margin) continue;
+      double own[3];
+      const bool facing = pressFacing(s, v, margin, h, depth, normal, own, [&](double& d, double nf[3]) {
+        return colliderDistance(col, p, margin, d, nf, own);
+      });
       Contact* ct = admit(list, bodies[i], i, -1, k, n, depth);
       if (!ct) continue;
       ct->friction = col.friction, ct->restitution = col.restitution;
       double deformed[3], ignored[3];
       worldVertex(s, v, true, deformed);
-      colliderDistance(col, deformed, INFINITY, ct->deformedDepth, ignored);
+      colliderDistance(col, deformed, INFINITY, ct->deformedDepth, ignored, facing ? own : nullptr);
       for (int a = 0; a < 3; ++a) {
         ct->point[a] = p[a], ct->normal[a] = normal[a], ct->surfaceVelocity[a] = u[a];
         ct->arm[a] = p[a] - s.frame.position[a];
@@ -382,25 +427,12 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
     worldVertex(a, v, false, p);
     const double reach = keptReach(list, margin, a.contactSlop);
     if (!bodyDistance(b, p, reach, depth, normal, &otherVertex) || depth > reach) continue;
-    // A touching vertex facing the same way as the surface it is nearest lies along it and cannot
-    // press on it: it presses on the nearest part of the surface that faces it. (Bars laid edge on
-    // edge had each rim vertex nearest the side face under the other's rim: its sideways normals
-    // rolled them over, 13-23 degrees, and they rested so, sunk into each other.) Unless that part
-    // is deeper than a touching contact sinks (a resting one: 3 slops and 2 g h^2, the soft
-    // contacts' most, solveContacts()) beyond the reach: then it is some other part of the body.
     double own[3];
-    const double* facing = nullptr;
-    if (depth <= a.contactSlop && a.model->surfaceMesh) {
-      a.frame.toWorldDirection(a.model->surfaceMesh->vertexNormals + 3 * v, own);
-      double facingDepth, facingNormal[3];
-      int facingVertex = 0;
-      const double deepest = reach + 3 * a.contactSlop + 2 * norm3(a.frame.gravity) * h * h;
-      if (dot3(own, normal) > 0 && bodyDistance(b, p, reach, facingDepth, facingNormal, &facingVertex, own) &&
-          std::fabs(facingDepth) <= deepest) {
-        facing = own, depth = facingDepth, otherVertex = facingVertex;
-        std::memcpy(normal, facingNormal, sizeof facingNormal);
-      }
-    }
+    int facingVertex = 0;
+    const bool facing = pressFacing(a, v, reach, h, depth, normal, own, [&](double& d, double nf[3]) {
+      return bodyDistance(b, p, reach, d, nf, &facingVertex, own);
+    });
+    if (facing) otherVertex = facingVertex;
     Contact* ct = admit(list, bodies[i], i, j, -1, n, depth);
     if (!ct) continue;
     ct->otherVertex = otherVertex;
@@ -409,7 +441,7 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
     // vertex moved along the normal (both deform).
     double deformed[3], ignored[3], u[3], uWorld[3];
     worldVertex(a, v, true, deformed);
-    bodyDistance(b, deformed, INFINITY, ct->deformedDepth, ignored, nullptr, facing);
+    bodyDistance(b, deformed, INFINITY, ct->deformedDepth, ignored, nullptr, facing ? own : nullptr);
     b.model->vertexLinear(otherVertex, b.q, u, nullptr);
     b.frame.toWorldDirection(u, uWorld);
     ct->deformedDepth -= dot3(uWorld, normal);
@@ -438,13 +470,17 @@ bool validCollider(const qv_collider& c) {
   }
 }
 
-bool colliderDistance(const qv_collider& c, const double p[3], double reach, double& distance, double normal[3]) {
+bool colliderDistance(const qv_collider& c, const double p[3], double reach, double& distance, double normal[3],
+                      const double* facing) {
   const double* d = c.data;
-  double R[9], local[3], localNormal[3];
+  double R[9], local[3], localNormal[3], localFacing[3];
   const bool turned = (c.type == QV_COLLIDER_BOX || c.type == QV_COLLIDER_MESH) && colliderRotation(c, R);
   if (c.type == QV_COLLIDER_BOX || c.type == QV_COLLIDER_MESH) {  // into the collider's own frame: R^T (p - centre)
     const double rel[3] = {p[0] - d[0], p[1] - d[1], p[2] - d[2]};
     for (int a = 0; a < 3; ++a) local[a] = turned ? R[a] * rel[0] + R[3 + a] * rel[1] + R[6 + a] * rel[2] : rel[a];
+    if (facing)
+      for (int a = 0; a < 3; ++a)
+        localFacing[a] = turned ? R[a] * facing[0] + R[3 + a] * facing[1] + R[6 + a] * facing[2] : facing[a];
   }
   switch (c.type) {
     case QV_COLLIDER_PLANE: {  // points with n . x = d
@@ -465,10 +501,14 @@ bool colliderDistance(const qv_collider& c, const double p[3], double reach, dou
       return true;
     }
     case QV_COLLIDER_BOX:
-      distance = boxDistance(local, d + 3, localNormal);
+      if (!facing) {
+        distance = boxDistance(local, d + 3, localNormal);
+      } else if (!boxFacingDistance(local, d + 3, localFacing, distance, localNormal)) {
+        return false;
+      }
       break;
     case QV_COLLIDER_MESH:
-      if (!c.mesh || !c.mesh->distance(local, reach, distance, localNormal)) return false;
+      if (!c.mesh || !c.mesh->distance(local, reach, distance, localNormal, nullptr, facing ? localFacing : nullptr)) return false;
       break;
     default: return false;
   }

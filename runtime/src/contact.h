@@ -48,8 +48,11 @@ struct ContactMaterial {
 };
 
 // Signed distance of `p` to `collider` and the outward normal there; false for an invalid
-// collider, or (meshes) when p is farther than `reach` from it.
-bool colliderDistance(const qv_collider& collider, const double p[3], double reach, double& distance, double normal[3]);
+// collider, or (meshes) when p is farther than `reach` from it. With `facing` (a world direction),
+// a box or a mesh counts only its faces facing against it (qv_triangle_mesh::distance); false when
+// none does.
+bool colliderDistance(const qv_collider& collider, const double p[3], double reach, double& distance, double normal[3],
+                      const double* facing = nullptr);
 bool validCollider(const qv_collider& collider);
 
 // Finds the step's contacts of `bodies` with `colliders` and with each other, solves their
