@@ -361,15 +361,16 @@ double keptReach(const ContactList& list, double margin, double slop) {
 // each rim vertex nearest the side face under the other's rim, and a bar laid flush with a box's
 // edge each vertex of its side: those sideways normals rolled the stacked bars over, 13-23
 // degrees, and the bar off the box. Not where that part is deeper than a touching contact sinks
-// (3 slops and 2 g h^2, the soft contacts' most at rest, solveContacts()) beyond the reach: that
-// is some other part of the surface. Returns whether it took that part's depth and normal.
+// (3 slops and 2 g h^2, the soft contacts' most at rest, solveContacts()) beyond the margin: that
+// is some other part of the surface. Returns whether it took that part's depth and normal (the
+// caller refuses it beyond its reach, as the first answer).
 template <class Query>
-bool pressFacing(const qv_instance& s, int v, double reach, double h, double& depth, double normal[3], double own[3],
+bool pressFacing(const qv_instance& s, int v, double margin, double h, double& depth, double normal[3], double own[3],
                  Query query) {
   if (depth > s.contactSlop || !s.model->surfaceMesh) return false;
   s.frame.toWorldDirection(s.model->surfaceMesh->vertexNormals + 3 * v, own);
   double facingDepth, facingNormal[3];
-  const double deepest = reach + 3 * s.contactSlop + 2 * norm3(s.frame.gravity) * h * h;
+  const double deepest = margin + 3 * s.contactSlop + 2 * norm3(s.frame.gravity) * h * h;
   if (dot3(own, normal) <= 0 || !query(facingDepth, facingNormal) || std::fabs(facingDepth) > deepest) return false;
   depth = facingDepth;
   std::memcpy(normal, facingNormal, sizeof facingNormal);
@@ -388,13 +389,14 @@ void findColliderContacts(ContactBody* bodies, int i, const qv_collider* collide
       const qv_collider& col = colliders[k];
       double u[3], depth, normal[3];
       surfaceVelocity(col, p, u);
-      const double margin = keptReach(list, s.contactSlop + 2 * h * std::fmax(relativeSpeed(bodies[i], u), bodies[i].groupSpeed),
-                                      s.contactSlop);
-      if (!colliderDistance(col, p, margin, depth, normal) || depth > margin) continue;
+      const double margin = s.contactSlop + 2 * h * std::fmax(relativeSpeed(bodies[i], u), bodies[i].groupSpeed);
+      const double reach = keptReach(list, margin, s.contactSlop);
+      if (!colliderDistance(col, p, reach, depth, normal) || depth > reach) continue;
       double own[3];
       const bool facing = pressFacing(s, v, margin, h, depth, normal, own, [&](double& d, double nf[3]) {
         return colliderDistance(col, p, margin, d, nf, own);
       });
+      if (depth > reach) continue;
       Contact* ct = admit(list, bodies[i], i, -1, k, n, depth);
       if (!ct) continue;
       ct->friction = col.friction, ct->restitution = col.restitution;
@@ -429,9 +431,10 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
     if (!bodyDistance(b, p, reach, depth, normal, &otherVertex) || depth > reach) continue;
     double own[3];
     int facingVertex = 0;
-    const bool facing = pressFacing(a, v, reach, h, depth, normal, own, [&](double& d, double nf[3]) {
-      return bodyDistance(b, p, reach, d, nf, &facingVertex, own);
+    const bool facing = pressFacing(a, v, margin, h, depth, normal, own, [&](double& d, double nf[3]) {
+      return bodyDistance(b, p, margin, d, nf, &facingVertex, own);
     });
+    if (depth > reach) continue;
     if (facing) otherVertex = facingVertex;
     Contact* ct = admit(list, bodies[i], i, j, -1, n, depth);
     if (!ct) continue;
