@@ -199,14 +199,19 @@ bool givenUpFirst(const Contact& x, const Contact& y) {
 // A heap with the contact given up first on top: moves heap[i] down to where it belongs; returns
 // where that is.
 int siftDown(Contact* heap, int count, int i) {
+  // The children move up into the hole it leaves, and it is copied once where it stops: a Contact
+  // is some 300 bytes, which a swap at each level copied three times.
+  const Contact moving = heap[i];
   for (;;) {
-    int top = i;
+    int top = -1;
     for (int c = 2 * i + 1; c <= 2 * i + 2 && c < count; ++c)
-      if (givenUpFirst(heap[c], heap[top])) top = c;
-    if (top == i) return i;
-    std::swap(heap[i], heap[top]);
+      if (givenUpFirst(heap[c], top < 0 ? moving : heap[top])) top = c;
+    if (top < 0) break;
+    heap[i] = heap[top];
     i = top;
   }
+  heap[i] = moving;
+  return i;
 }
 
 void makeHeap(Contact* heap, int count) {
