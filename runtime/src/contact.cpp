@@ -301,6 +301,11 @@ double relativeSpeed(const ContactBody& b, const double velocity[3]) {
   return norm3(d) + norm3(b.omega) * b.instance->surfaceRadius;
 }
 
+// How fast bodies a and b's surfaces can approach each other.
+double pairSpeed(const ContactBody& a, const ContactBody& b) {
+  return relativeSpeed(a, b.velocity) + norm3(b.omega) * b.instance->surfaceRadius;
+}
+
 int groupOf(ContactBody* bodies, int i) {
   while (bodies[i].group != i) i = bodies[i].group = bodies[bodies[i].group].group;
   return i;
@@ -337,7 +342,7 @@ void spreadSpeeds(ContactBody* bodies, int count, const qv_collider* colliders, 
       if (norm3(gap) > a.surfaceRadius + b.surfaceRadius + std::fmax(a.contactSlop, b.contactSlop) +
                            2 * h * (bodies[i].ownSpeed + bodies[j].ownSpeed))
         continue;
-      const double speed = relativeSpeed(bodies[i], bodies[j].velocity) + norm3(bodies[j].omega) * b.surfaceRadius;
+      const double speed = pairSpeed(bodies[i], bodies[j]);
       bodies[i].touchSpeed = std::fmax(bodies[i].touchSpeed, speed);
       bodies[j].touchSpeed = std::fmax(bodies[j].touchSpeed, speed);
       bodies[groupOf(bodies, i)].group = groupOf(bodies, j);
@@ -422,8 +427,7 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
   const qv_instance &a = *bodies[i].instance, &b = *bodies[j].instance;
   if (!b.model->surfaceMesh) return;
   const double margin = std::fmax(a.contactSlop, b.contactSlop) +
-                        2 * h * std::fmax(relativeSpeed(bodies[i], bodies[j].velocity) + norm3(bodies[j].omega) * b.surfaceRadius,
-                                          bodies[i].groupSpeed);
+                        2 * h * std::fmax(pairSpeed(bodies[i], bodies[j]), bodies[i].groupSpeed);
   double gap[3];
   for (int k = 0; k < 3; ++k) gap[k] = a.frame.position[k] - b.frame.position[k];
   if (norm3(gap) > a.surfaceRadius + b.surfaceRadius + margin) return;
