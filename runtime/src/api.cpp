@@ -285,18 +285,23 @@ void qv_instance_last_step(const qv_instance* s, qv_step_report* report) {
 
 qv_result qv_instance_add_vertex_force(qv_instance* s, int vertex, const double force[3]) {
   if (!s || !force || !validVertex(s, vertex)) return QV_ERROR_INVALID_ARGUMENT;
+  if (force[0] != 0 || force[1] != 0 || force[2] != 0) s->wake();  // a game's zero wind each frame lets it sleep
   s->addVertexForce(vertex, force);
   return QV_OK;
 }
 
 qv_result qv_instance_add_reduced_force(qv_instance* s, const double* force) {
   if (!s || !force) return QV_ERROR_INVALID_ARGUMENT;
+  for (int i = 0; i < s->r; ++i)
+    if (force[i] != 0) s->wake();
   s->loads.addReducedForce(force);
   return QV_OK;
 }
 
 void qv_instance_set_gravity(qv_instance* s, const double g[3]) {
-  if (s && g) s->setGravity(g);
+  if (!s || !g) return;
+  if (s->flying() && std::memcmp(g, s->frame.gravity, sizeof s->frame.gravity) != 0) s->wake();
+  s->setGravity(g);
 }
 
 qv_result qv_instance_set_constraint(qv_instance* s, int slot, const int* vertices, int count, const double* targets,
@@ -320,7 +325,9 @@ void qv_instance_get_state(const qv_instance* s, double* q, double* v, double* a
 }
 
 void qv_instance_set_state(qv_instance* s, const double* q, const double* v, const double* a) {
-  if (s) s->setState(q, v, a);
+  if (!s) return;
+  s->wake();
+  s->setState(q, v, a);
 }
 
 size_t qv_instance_snapshot_size(const qv_instance* s) { return s ? s->snapshotSize() : 0; }
@@ -332,11 +339,14 @@ void qv_instance_save_snapshot(const qv_instance* s, void* snapshot) {
 qv_result qv_instance_restore_snapshot(qv_instance* s, const void* snapshot, size_t size) {
   if (!s || !snapshot || size != s->snapshotSize() || reinterpret_cast<uintptr_t>(snapshot) % alignof(double) != 0)
     return QV_ERROR_INVALID_ARGUMENT;
+  s->wake();
   return s->restoreSnapshot(static_cast<const double*>(snapshot)) ? QV_OK : QV_ERROR_INVALID_ARGUMENT;
 }
 
 void qv_instance_reset(qv_instance* s) {
-  if (s) s->rest();
+  if (!s) return;
+  s->wake();
+  s->rest();
 }
 
 void qv_instance_energies(const qv_instance* s, double* kinetic, double* elastic) {
@@ -363,6 +373,7 @@ qv_result qv_instance_set_rigid_state(qv_instance* s, const qv_rigid_state* stat
         !std::isfinite(state->angular_velocity[a]))
       return QV_ERROR_INVALID_ARGUMENT;
   if (!(norm > 0) || !std::isfinite(norm)) return QV_ERROR_INVALID_ARGUMENT;
+  s->wake();
   quiver::rt::RigidFrame& f = s->frame;
   std::memcpy(f.position, state->position, sizeof f.position);
   f.setOrientation(state->orientation);
@@ -462,10 +473,17 @@ qv_result qv_world_set_colliders(qv_world* world, const qv_collider* colliders, 
   if (!world || !validColliders(colliders, count)) return QV_ERROR_INVALID_ARGUMENT;
   world->colliders = count ? colliders : nullptr;
   world->colliderCount = count;
+  for (int i = 0; i < world->count; ++i) world->instances[i]->wake();
   return QV_OK;
 }
 
 int qv_world_step(qv_world* world) { return world ? world->step() : 0; }
+
+int qv_instance_asleep(const qv_instance* s) { return s && s->asleep; }
+
+void qv_instance_wake(qv_instance* s) {
+  if (s) s->wake();
+}
 
 int qv_world_contacts(const qv_world* world, qv_contact* contacts, int capacity) {
   return world ? copyContacts(world->contacts, contacts, capacity) : 0;

@@ -328,6 +328,7 @@ void spreadSpeeds(ContactBody* bodies, int count, const qv_collider* colliders, 
       surfaceVelocity(colliders[k], s.frame.position, u);
       // The collider's spin moves its surface within reach faster than at the body's centre.
       const double speed = relativeSpeed(b, u) + norm3(colliders[k].angular_velocity) * s.surfaceRadius;
+      if (!(speed > 0)) continue;  // adds nothing (a sleeper beside a still collider: no query)
       const double reach = s.surfaceRadius + s.contactSlop + 2 * h * speed;
       if (colliderDistance(colliders[k], s.frame.position, reach, distance, normal) && distance <= reach)
         b.touchSpeed = std::fmax(b.touchSpeed, speed);
@@ -352,7 +353,36 @@ void spreadSpeeds(ContactBody* bodies, int count, const qv_collider* colliders, 
     ContactBody& root = bodies[groupOf(bodies, i)];
     root.groupSpeed = std::fmax(root.groupSpeed, bodies[i].touchSpeed);
   }
-  for (int i = 0; i < count; ++i) bodies[i].groupSpeed = bodies[groupOf(bodies, i)].groupSpeed;
+  for (int i = 0; i < count; ++i) {
+    bodies[i].group = groupOf(bodies, i);
+    bodies[i].groupSpeed = bodies[bodies[i].group].groupSpeed;
+  }
+}
+
+// The margin of body i's vertices against body j's surface (findBodyContacts()), and whether their
+// bounding spheres come within it.
+double bodyMargin(const ContactBody* bodies, int i, int j, double h) {
+  const qv_instance &a = *bodies[i].instance, &b = *bodies[j].instance;
+  return std::fmax(a.contactSlop, b.contactSlop) + 2 * h * std::fmax(pairSpeed(bodies[i], bodies[j]), bodies[i].groupSpeed);
+}
+
+bool withinMargin(const ContactBody* bodies, int i, int j, double margin) {
+  const qv_instance &a = *bodies[i].instance, &b = *bodies[j].instance;
+  double gap[3];
+  for (int k = 0; k < 3; ++k) gap[k] = a.frame.position[k] - b.frame.position[k];
+  return norm3(gap) <= a.surfaceRadius + b.surfaceRadius + margin;
+}
+
+// The solve starts from the frames' momenta as their velocity updates left them.
+void takeMomenta(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h) {
+  for (int i = 0; i < count; ++i) {
+    ContactBody& b = bodies[i];
+    const RigidFrame& f = b.instance->frame;
+    std::memcpy(b.velocity, f.velocity, sizeof b.velocity);
+    std::memcpy(b.angularMomentum, f.angularMomentum, sizeof b.angularMomentum);
+    f.worldOmega(b.omega);
+  }
+  spreadSpeeds(bodies, count, colliders, colliderCount, h);
 }
 
 // How far from a surface a candidate can be and still be kept: a full list takes only those its
@@ -426,11 +456,8 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
                       ContactList& list) {
   const qv_instance &a = *bodies[i].instance, &b = *bodies[j].instance;
   if (!b.model->surfaceMesh) return;
-  const double margin = std::fmax(a.contactSlop, b.contactSlop) +
-                        2 * h * std::fmax(pairSpeed(bodies[i], bodies[j]), bodies[i].groupSpeed);
-  double gap[3];
-  for (int k = 0; k < 3; ++k) gap[k] = a.frame.position[k] - b.frame.position[k];
-  if (norm3(gap) > a.surfaceRadius + b.surfaceRadius + margin) return;
+  const double margin = bodyMargin(bodies, i, j, h);
+  if (!withinMargin(bodies, i, j, margin)) return;
   for (int n = 0; n < a.surfaceCount; ++n) {
     const int v = a.surfaceVertices[n];
     double p[3], depth, normal[3];
@@ -529,20 +556,33 @@ bool colliderDistance(const qv_collider& c, const double p[3], double reach, dou
   return true;
 }
 
+int wakeSleepers(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h) {
+  takeMomenta(bodies, count, colliders, colliderCount, h);
+  for (int i = 0; i < count; ++i) bodies[i].wakes = false;
+  for (int i = 0; i < count; ++i) {
+    const bool asleep = bodies[i].instance->asleep;
+    // A sleeper's speeds are zero: any it has to something is a moving collider's.
+    if (!asleep || bodies[i].touchSpeed > 0) bodies[bodies[i].group].wakes = true;
+    if (asleep) continue;
+    // Beyond its group: its margins grow with its group's speed (a sleeper's never exceed an
+    // awake body's, so this side decides).
+    for (int j = 0; j < count; ++j)
+      if (bodies[j].instance->asleep && withinMargin(bodies, i, j, bodyMargin(bodies, i, j, h)))
+        bodies[bodies[j].group].wakes = true;
+  }
+  int woken = 0;
+  for (int i = 0; i < count; ++i)
+    if (bodies[i].instance->asleep && bodies[bodies[i].group].wakes) bodies[i].instance->wake(), ++woken;
+  return woken;
+}
+
 void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* colliders, int colliderCount,
                    const ContactMaterial& material, ContactList& list, double h) {
   std::swap(list.contacts, list.previous);
   list.previousCount = list.count;
   list.count = 0;
   list.full = false;
-  for (int i = 0; i < bodyCount; ++i) {
-    ContactBody& b = bodies[i];
-    const RigidFrame& f = b.instance->frame;
-    std::memcpy(b.velocity, f.velocity, sizeof b.velocity);
-    std::memcpy(b.angularMomentum, f.angularMomentum, sizeof b.angularMomentum);
-    f.worldOmega(b.omega);
-  }
-  spreadSpeeds(bodies, bodyCount, colliders, colliderCount, h);
+  takeMomenta(bodies, bodyCount, colliders, colliderCount, h);
   // Contacts: each surface vertex of the rest shape carried by the frame. Found and solved on the
   // rigid shape: the deformation takes the forces but does not move the contacts (taking its
   // vertices made the loads on q and the contacts chase each other: a resting bar fluttered, bent
@@ -550,9 +590,10 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
   const auto find = [&] {
     for (int i = 0; i < bodyCount; ++i) {
       if (!list.reducing) bodies[i].firstPair = bodies[i].pairEnd = list.pairCount;
+      if (bodies[i].instance->asleep) continue;
       findColliderContacts(bodies, i, colliders, colliderCount, h, list);
       for (int j = 0; j < bodyCount; ++j)
-        if (j != i) findBodyContacts(bodies, i, j, h, material, list);
+        if (j != i && !bodies[j].instance->asleep) findBodyContacts(bodies, i, j, h, material, list);
     }
   };
   list.pairCount = list.touching = 0;

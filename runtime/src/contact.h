@@ -38,8 +38,10 @@ struct ContactBody {
   // Its group: the bodies it could touch in the step (either stopped), and the ones those could
   // touch. The fastest relative speed of one of them against what it could touch sets its
   // speculative margins (spreadSpeeds(), contact.cpp). ownSpeed: its surface's, in the world.
+  // Its root after a solve or wakeSleepers(); `wakes`: a root whose group wakes.
   int group = 0;
   double ownSpeed = 0, touchSpeed = 0, groupSpeed = 0;
+  bool wakes = false;
 };
 
 // Friction and restitution between two instances (a collider brings its own).
@@ -57,8 +59,15 @@ bool validCollider(const qv_collider& collider);
 
 // Finds the step's contacts of `bodies` with `colliders` and with each other, solves their
 // impulses into the frames' velocities and angular momenta, and adds their forces on q. Call after
-// the frames' velocity updates, before they move; all bodies share the time step h.
+// the frames' velocity updates, before they move; all bodies share the time step h. Sleeping
+// bodies (qv_instance::asleep, at rest) take no part: none may be within an awake body's reach
+// (wakeSleepers()).
 void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* colliders, int colliderCount,
                    const ContactMaterial& between, ContactList& list, double h);
+
+// Wakes every sleeping body whose group (as the solve will group them) holds an awake body or
+// meets a moving collider, and every one within an awake body's margin; returns how many. Woken
+// bodies start their step and move, so call again until it wakes none.
+int wakeSleepers(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h);
 
 } // namespace quiver::rt

@@ -122,6 +122,7 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
   work.presetForce = c.take<double>(r);
   if (flying()) {
     frame.attach(c.take<double>(quiver::rt::RigidFrame::scratchDoubles(r)), r);
+    startQ = c.take<double>(r);
     contacts.contacts = c.take<quiver::rt::Contact>(static_cast<size_t>(config.max_contacts));
     contacts.previous = c.take<quiver::rt::Contact>(static_cast<size_t>(config.max_contacts));
     contacts.pairs = c.take<quiver::rt::ContactPair>(static_cast<size_t>(config.max_contacts));

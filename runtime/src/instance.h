@@ -96,6 +96,11 @@ struct qv_instance {
   int surfaceCount = 0;
   double surfaceRadius = 0;        // m: the farthest surface vertex from the centre of mass, at rest
   double contactSlop = 0;          // m: penetration left alone
+  // In a world (world.h): asleep, not stepped until woken; still for stillTime s (slower than its
+  // sleep speed). Whatever the caller changes wakes it (api.cpp).
+  bool asleep = false;
+  double stillTime = 0;
+  double* startQ = nullptr;  // in flight: q at a world step's start, to measure how far it moved q
 
   void carve(quiver::rt::BlockCarver& c);
   void rest();
@@ -109,6 +114,7 @@ struct qv_instance {
   // leave it: for a state set from outside (setState(), a fixed Newton step the minimiser takes over).
   void dampingStiffnessAtState(double* D) const;
   bool flying() const { return config.free_flight != 0; }
+  void wake() { asleep = false, stillTime = 0; }
   // Its steps are the minimiser's, which keeps E(q), the energy slack and D from step to step.
   bool minimizes() const {
     return config.solver == QV_SOLVER_MINIMIZE && config.integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES;

@@ -1,6 +1,7 @@
 #include "world.h"
 
 #include <cmath>
+#include <cstring>
 #include <new>
 
 #include "block_carver.h"
@@ -9,12 +10,34 @@ namespace quiver::rt {
 
 namespace {
 
+// How fast an instance still moves: its frame's surface (the fastest spin at its farthest vertex)
+// and its deformation's RMS speed over the step, |q - startQ| / (h sqrt(m)) (as |q'|^2 / 2 is its
+// kinetic energy). Not |q'| / sqrt(m): the implicit steps leave stiff modes' velocities ringing
+// from step to step, undamped, while q hardly moves (a bar vibrating in space kept 3 cm/s after 10 s).
+double stillSpeed(const qv_instance& s, double h) {
+  double omega[3], dq2 = 0;
+  s.frame.inverseInertia(s.frame.angularMomentum, omega);
+  for (int i = 0; i < s.r; ++i) dq2 += (s.q[i] - s.startQ[i]) * (s.q[i] - s.startQ[i]);
+  return std::hypot(s.frame.velocity[0], s.frame.velocity[1], s.frame.velocity[2]) +
+         std::hypot(omega[0], omega[1], omega[2]) * s.surfaceRadius + std::sqrt(dq2 / s.model->info.total_mass) / h;
+}
+
+// At rest where it is: its pose and deformation kept, its velocities zero.
+void fallAsleep(qv_instance& s) {
+  s.asleep = true;
+  std::memset(s.v, 0, sizeof(double) * s.r);
+  std::memset(s.frame.velocity, 0, sizeof s.frame.velocity);
+  std::memset(s.frame.angularMomentum, 0, sizeof s.frame.angularMomentum);
+  s.frame.refresh(*s.model, s.q, s.v);
+}
+
 // Measures (block null) or places the world's arrays; returns the block's size.
 size_t layOut(const qv_world_config& config, char* block, qv_world** world) {
   BlockCarver c(block);
   qv_world* w = c.take<qv_world>(1);
   qv_instance** instances = c.take<qv_instance*>(static_cast<size_t>(config.max_instances));
   ContactBody* bodies = c.take<ContactBody>(static_cast<size_t>(config.max_instances));
+  WorldSlot* slots = c.take<WorldSlot>(static_cast<size_t>(config.max_instances));
   Contact* contacts = c.take<Contact>(static_cast<size_t>(config.max_contacts));
   Contact* previous = c.take<Contact>(static_cast<size_t>(config.max_contacts));
   ContactPair* pairs = c.take<ContactPair>(static_cast<size_t>(config.max_contacts));
@@ -23,6 +46,7 @@ size_t layOut(const qv_world_config& config, char* block, qv_world** world) {
     w->config = config;
     w->instances = instances;
     w->bodies = new (bodies) ContactBody[config.max_instances];
+    w->slots = new (slots) WorldSlot[config.max_instances];
     w->contacts.contacts = contacts;
     w->contacts.previous = previous;
     w->contacts.pairs = pairs;
@@ -36,7 +60,8 @@ size_t layOut(const qv_world_config& config, char* block, qv_world** world) {
 
 bool validWorldConfig(const qv_world_config& c) {
   return c.max_instances >= 1 && c.max_instances <= 65536 && c.max_contacts >= 0 && c.max_contacts <= (1 << 20) &&
-         c.friction >= 0 && std::isfinite(c.friction) && c.restitution >= 0 && c.restitution <= 1;
+         c.friction >= 0 && std::isfinite(c.friction) && c.restitution >= 0 && c.restitution <= 1 &&
+         c.sleep_speed >= 0 && std::isfinite(c.sleep_speed) && c.sleep_time >= 0 && std::isfinite(c.sleep_time);
 }
 
 void defaultWorldConfig(qv_world_config& config) {
@@ -44,6 +69,8 @@ void defaultWorldConfig(qv_world_config& config) {
   config.max_contacts = 4096;
   config.friction = 0.5;
   config.restitution = 0;
+  config.sleep_speed = 0.02;
+  config.sleep_time = 0.5;
 }
 
 qv_world* createWorld(const qv_world_config& config, const qv_allocator& allocator) {
@@ -65,14 +92,48 @@ void destroyWorld(qv_world* world) {
 } // namespace quiver::rt
 
 int qv_world::step() {
+  if (!count) return 0;
+  const double h = instances[0]->config.time_step;
   for (int i = 0; i < count; ++i) {
-    instances[i]->beginStep();
-    instances[i]->contacts.clear();
     bodies[i].instance = instances[i];
+    if (!instances[i]->asleep) begin(i);
   }
+  // Woken bodies start their step and may reach other sleepers in it.
+  bool sleepers = false;
+  for (int i = 0; i < count; ++i) sleepers |= instances[i]->asleep;
+  while (sleepers && quiver::rt::wakeSleepers(bodies, count, colliders, colliderCount, h))
+    for (int i = 0; i < count; ++i)
+      if (!instances[i]->asleep && !slots[i].begun) begin(i);
   const quiver::rt::ContactMaterial between{config.friction, config.restitution};
-  if (count) quiver::rt::solveContacts(bodies, count, colliders, colliderCount, between, contacts, instances[0]->config.time_step);
+  quiver::rt::solveContacts(bodies, count, colliders, colliderCount, between, contacts, h);
   int resets = 0;
-  for (int i = 0; i < count; ++i) resets += instances[i]->finishStep() == QV_STEP_RESET;
+  for (int i = 0; i < count; ++i)
+    if (!instances[i]->asleep) resets += instances[i]->finishStep() == QV_STEP_RESET;
+  settle(h);
   return resets;
+}
+
+void qv_world::begin(int i) {
+  qv_instance& s = *instances[i];
+  std::memcpy(s.startQ, s.q, sizeof(double) * s.r);
+  s.beginStep();
+  s.contacts.clear();
+  slots[i].begun = true;
+}
+
+void qv_world::settle(double h) {
+  for (int i = 0; i < count; ++i) slots[i].begun = false;
+  if (!(config.sleep_speed > 0)) return;
+  // Each group's shortest still time, at its root (the solve's groups: a group is all awake or all
+  // asleep), then the groups still long enough fall asleep together.
+  for (int i = 0; i < count; ++i) slots[i].groupStill = INFINITY;
+  for (int i = 0; i < count; ++i) {
+    qv_instance& s = *instances[i];
+    if (s.asleep) continue;
+    s.stillTime = quiver::rt::stillSpeed(s, h) < config.sleep_speed ? s.stillTime + h : 0;
+    double& least = slots[bodies[i].group].groupStill;
+    least = std::fmin(least, s.stillTime);
+  }
+  for (int i = 0; i < count; ++i)
+    if (!instances[i]->asleep && slots[bodies[i].group].groupStill >= config.sleep_time) quiver::rt::fallAsleep(*instances[i]);
 }

@@ -3,18 +3,33 @@
 // block from the caller's allocator, sized by its config; the step allocates nothing.
 #include "contact.h"
 
+namespace quiver::rt {
+
+// A body's part in a world step: whether its step has begun; at a group's root, the group's
+// shortest still time (qv_instance::stillTime).
+struct WorldSlot {
+  bool begun = false;
+  double groupStill = 0;
+};
+
+} // namespace quiver::rt
+
 struct qv_world {
   qv_allocator allocator;
   qv_world_config config;
   qv_instance** instances = nullptr;  // the caller's, in qv_world_add's order
   int count = 0;
   quiver::rt::ContactBody* bodies = nullptr;
+  quiver::rt::WorldSlot* slots = nullptr;
   quiver::rt::ContactList contacts;
   const qv_collider* colliders = nullptr;  // the caller's (qv_world_set_colliders)
   int colliderCount = 0;
 
-  // Each instance's frame forces, one contact solve over all, then each move and deformation.
+  // Each awake instance's frame forces, one contact solve over all, then each move and deformation;
+  // then the groups that have been still long enough fall asleep.
   int step();
+  void begin(int i);
+  void settle(double h);
 };
 
 namespace quiver::rt {

@@ -3,7 +3,9 @@
 // measured from the world positions (consistent mass, central differences) do not change, and a
 // perfectly plastic hit leaves both at half the speed; bars falling together do not fall into each
 // other when the lowest lands, and bars laid edge on edge stay level; a pile of 20 dropped bars
-// comes to rest.
+// comes to rest. Sleeping: a settled pile falls asleep where it rested (as the same pile awake
+// rests) and does not move; a bar dropped on a sleeping stack, a platform starting to move, a
+// push, new gravity and a ground taken away wake it; a vibrating bar does not fall asleep.
 // Bad use is refused.
 #include <gtest/gtest.h>
 
@@ -29,12 +31,14 @@ struct World {
   qv_world* w = nullptr;
   std::vector<std::unique_ptr<test::Instance>> bodies;
   std::vector<qv_collider> colliders;
-  explicit World(double friction = 0.5, double restitution = 0, int maxContacts = 4096) {
+  // Sleeping off unless asked for: most tests here watch contacts at rest.
+  explicit World(double friction = 0.5, double restitution = 0, int maxContacts = 4096, double sleepSpeed = 0) {
     qv_world_config c;
     qv_world_config_init(&c);
     c.friction = friction;
     c.restitution = restitution;
     c.max_contacts = maxContacts;
+    c.sleep_speed = sleepSpeed;
     EXPECT_EQ(qv_world_create(&c, nullptr, &w), QV_OK);
   }
   ~World() { qv_world_destroy(w); }
@@ -205,18 +209,15 @@ TEST(World, ACollisionInSpaceKeepsTheMomentaAndAPlasticHitSharesTheSpeed) {
   }
 }
 
-TEST(World, APileOfTwentyDroppedBarsComesToRest) {
-  FreeBar bar(16, {6, 1, 1});
-  const double h = 1.0 / 60;
-  World world(0.5, 0, 4096);
-  // A bin 0.8 x 0.8 m: the ground and four walls.
+// Twenty bars dropped into a bin 0.8 x 0.8 m (the ground and four walls) in five layers of four,
+// each layer crosswise to the one below, a little turned and shaken.
+void dropTwentyIntoABin(World& world, const FreeBar& bar, double h) {
   world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0),
                      makeCollider(QV_COLLIDER_PLANE, {1, 0, 0, -0.4, 0, 0, 0, 0}, 0.5, 0),
                      makeCollider(QV_COLLIDER_PLANE, {-1, 0, 0, -0.4, 0, 0, 0, 0}, 0.5, 0),
                      makeCollider(QV_COLLIDER_PLANE, {0, 1, 0, -0.4, 0, 0, 0, 0}, 0.5, 0),
                      makeCollider(QV_COLLIDER_PLANE, {0, -1, 0, -0.4, 0, 0, 0, 0}, 0.5, 0)};
   world.setColliders();
-  // Five layers of four, each layer crosswise to the one below, a little turned and shaken.
   std::mt19937 rng(1);
   std::uniform_real_distribution<double> jitter(-0.05, 0.05);
   for (int layer = 0; layer < 5; ++layer)
@@ -230,6 +231,13 @@ TEST(World, APileOfTwentyDroppedBarsComesToRest) {
       s.orientation[3] = std::sin(yaw / 2) * std::cos(tilt / 2);
       world.add(bar, h, s, true);
     }
+}
+
+TEST(World, APileOfTwentyDroppedBarsComesToRest) {
+  FreeBar bar(16, {6, 1, 1});
+  const double h = 1.0 / 60;
+  World world(0.5, 0, 4096);
+  dropTwentyIntoABin(world, bar, h);
   double deepest = 0, fastest = 0, spin = 0;
   int resets = 0, maxContacts = 0;
   for (int i = 0; i < 360; ++i) {  // 6 s
@@ -262,6 +270,179 @@ TEST(World, APileOfTwentyDroppedBarsComesToRest) {
   EXPECT_LT(deepest, 0.008);
 }
 
+constexpr double kSleepSpeed = 0.02;  // qv_world_config's default
+
+Eigen::Vector3d centre(qv_instance* s) {
+  qv_rigid_state state;
+  qv_instance_get_rigid_state(s, &state);
+  return {state.position[0], state.position[1], state.position[2]};
+}
+
+int asleep(const World& world) {
+  int n = 0;
+  for (const auto& b : world.bodies) n += qv_instance_asleep(b->s);
+  return n;
+}
+
+// The same pile twice, sleeping and awake. Asleep, it must rest where the awake one rests (a
+// group put to sleep while still settling would stay where it was caught), not move at all, and
+// have no contacts.
+TEST(World, ASettledPileFallsAsleepWhereItRestsAndStaysThere) {
+  FreeBar bar(16, {6, 1, 1});
+  const double h = 1.0 / 60;
+  World sleeping(0.5, 0, 4096, kSleepSpeed), awake(0.5, 0, 4096, 0);
+  dropTwentyIntoABin(sleeping, bar, h);
+  dropTwentyIntoABin(awake, bar, h);
+  int allAsleepAt = -1;
+  for (int i = 0; i < 480 && allAsleepAt < 0; ++i) {  // 8 s at most
+    ASSERT_EQ(qv_world_step(sleeping.w), 0);
+    if (asleep(sleeping) == 20) allAsleepAt = i;
+  }
+  ASSERT_GE(allAsleepAt, 0) << asleep(sleeping) << " of 20 asleep after 8 s";
+  for (int i = 0; i <= allAsleepAt + 120; ++i) ASSERT_EQ(qv_world_step(awake.w), 0);  // 2 s longer
+  std::vector<std::vector<float>> before;
+  for (auto& b : sleeping.bodies) {
+    before.emplace_back(3 * bar.info.vertex_count);
+    qv_instance_positions(b->s, before.back().data());
+  }
+  for (int i = 0; i < 120; ++i) ASSERT_EQ(qv_world_step(sleeping.w), 0);
+  double apart = 0;
+  for (size_t k = 0; k < sleeping.bodies.size(); ++k) {
+    std::vector<float> now(3 * bar.info.vertex_count);
+    qv_instance_positions(sleeping.bodies[k]->s, now.data());
+    EXPECT_EQ(now, before[k]) << "body " << k << " moved asleep";
+    apart = std::max(apart, (centre(sleeping.bodies[k]->s) - centre(awake.bodies[k]->s)).norm());
+  }
+  std::printf("pile of 20: all asleep after %.2f s; 2 s later each centre within %.3g mm of the same pile kept awake\n",
+              (allAsleepAt + 1) * h, 1e3 * apart);
+  EXPECT_EQ(asleep(sleeping), 20);
+  EXPECT_TRUE(sleeping.contacts().empty());
+  EXPECT_LT(apart, 0.002);
+}
+
+// Two bars crosswise on the ground, asleep; a third dropped from 0.3 m above must wake them and
+// land on them, not pass through the sleepers (their contacts are not sought while they sleep).
+TEST(World, ABarDroppedOnASleepingStackWakesItAndLandsOnIt) {
+  FreeBar bar(16, {12, 2, 2});
+  const double h = 1.0 / 60;
+  World world(0.5, 0, 4096, kSleepSpeed);
+  world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0)};
+  world.setColliders();
+  qv_rigid_state turned = at(0.3, 0.05, 0.155);
+  turned.orientation[0] = turned.orientation[3] = std::sqrt(0.5);
+  world.add(bar, h, at(0.3, 0.05, 0.052), true);
+  world.add(bar, h, turned, true);
+  for (int i = 0; i < 120 && asleep(world) < 2; ++i) ASSERT_EQ(qv_world_step(world.w), 0);
+  ASSERT_EQ(asleep(world), 2);
+  world.add(bar, h, at(0.3, 0.05, 0.55), true);
+  bool woke = false;
+  for (int i = 0; i < 180; ++i) {
+    ASSERT_EQ(qv_world_step(world.w), 0);
+    woke |= asleep(world) == 0 && centre(world.bodies[2]->s).z() < 0.35;
+  }
+  const double top = centre(world.bodies[2]->s).z();
+  std::printf("a bar dropped on a sleeping stack of two: it woke: %s; the dropped bar rests at %.4f m (0.25)\n",
+              woke ? "yes" : "no", top);
+  EXPECT_TRUE(woke);
+  EXPECT_NEAR(top, 0.25, 0.01);
+}
+
+// A bar asleep on a box (a platform, the caller moving it with a velocity) wakes when the platform
+// starts to move and rides it by friction; it sleeps again once the platform stops.
+TEST(World, ASleepingBarWakesWhenItsPlatformMovesAndRidesIt) {
+  FreeBar bar(16, {12, 2, 2});
+  const double h = 1.0 / 60, speed = 0.3;
+  World world(0.8, 0, 4096, kSleepSpeed);
+  world.colliders = {makeCollider(QV_COLLIDER_BOX, {0.3, 0.05, -0.05, 1, 1, 0.05, 0, 0}, 0.8, 0)};
+  world.setColliders();
+  qv_instance* s = world.add(bar, h, at(0.3, 0.05, 0.052), true);
+  for (int i = 0; i < 120 && !qv_instance_asleep(s); ++i) ASSERT_EQ(qv_world_step(world.w), 0);
+  ASSERT_TRUE(qv_instance_asleep(s));
+  const double x0 = centre(s).x();
+  // 1 s along x, accelerating gently (at most 0.94 m/s^2, within friction's 7.8) to `speed` and back.
+  for (int i = 0; i < 60; ++i) {
+    const double t = (i + 0.5) * h, v = speed * std::sin(M_PI * t);
+    world.colliders[0].velocity[0] = v;
+    world.colliders[0].data[0] += v * h;
+    ASSERT_EQ(qv_world_step(world.w), 0);
+  }
+  const double carried = world.colliders[0].data[0] - 0.3, moved = centre(s).x() - x0;
+  world.colliders[0].velocity[0] = 0;
+  bool sleepsAgain = false;
+  for (int i = 0; i < 120; ++i) {
+    ASSERT_EQ(qv_world_step(world.w), 0);
+    sleepsAgain |= qv_instance_asleep(s) != 0;
+  }
+  std::printf("platform moved %.4f m; the bar on it, asleep before, %.4f m; asleep again after it stopped: %s\n", carried,
+              moved, sleepsAgain ? "yes" : "no");
+  EXPECT_NEAR(moved, carried, 0.05 * carried);
+  EXPECT_TRUE(sleepsAgain);
+}
+
+// Whatever the caller does to a sleeping bar wakes it: a push, gravity turned up, the ground taken
+// away. The same gravity again, or a zero force, does not.
+TEST(World, APushNewGravityOrAGroundTakenAwayWakesASleeper) {
+  FreeBar bar(16, {12, 2, 2});
+  const double h = 1.0 / 60;
+  World world(0.5, 0, 4096, kSleepSpeed);
+  world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0)};
+  world.setColliders();
+  qv_instance* s = world.add(bar, h, at(0.3, 0.05, 0.052), true);
+  const auto settle = [&] {
+    for (int i = 0; i < 240 && !qv_instance_asleep(s); ++i) ASSERT_EQ(qv_world_step(world.w), 0);
+    ASSERT_TRUE(qv_instance_asleep(s));
+  };
+  settle();
+  const double zero[3] = {0, 0, 0}, g[3] = {0, 0, -kG}, up[3] = {0, 0, kG}, lift[3] = {0, 0, 500};
+  EXPECT_EQ(qv_instance_add_vertex_force(s, 0, zero), QV_OK);
+  qv_instance_set_gravity(s, g);
+  qv_world_step(world.w);
+  EXPECT_TRUE(qv_instance_asleep(s)) << "a zero force or the same gravity woke it";
+  const double z0 = centre(s).z();
+  EXPECT_EQ(qv_instance_add_vertex_force(s, 0, lift), QV_OK);  // 500 N at a corner for a step: 8 N s on 6 kg
+  qv_world_step(world.w);
+  EXPECT_FALSE(qv_instance_asleep(s));
+  EXPECT_GT(centre(s).z(), z0);  // its corner rose
+  settle();
+  qv_instance_set_gravity(s, up);
+  for (int i = 0; i < 30; ++i) qv_world_step(world.w);
+  EXPECT_GT(centre(s).z(), z0 + 0.1) << "gravity turned up did not lift it";
+  qv_instance_set_gravity(s, g);
+  for (int i = 0; i < 120; ++i) qv_world_step(world.w);  // back on the ground
+  settle();
+  world.colliders.clear();
+  world.setColliders();
+  for (int i = 0; i < 30; ++i) qv_world_step(world.w);
+  std::printf("pushed, gravity up and the ground taken away, the sleeping bar moved; fell to %.3f m\n", centre(s).z());
+  EXPECT_LT(centre(s).z(), z0 - 0.5 * kG * 0.25 * 0.9);  // half a second of free fall
+}
+
+// In space, still but vibrating (its first mode bent, lightly damped): it must not fall asleep
+// with the bend frozen in, only once the vibration has died down.
+TEST(World, AVibratingBarDoesNotFallAsleep) {
+  FreeBar bar(16, {12, 2, 2});
+  const double h = 1.0 / 60;
+  World world(0.5, 0, 4096, kSleepSpeed);
+  qv_instance* s = world.add(bar, h, at(0, 0, 0), false);
+  std::vector<double> q(bar.info.r, 0.0);
+  q[0] = 0.05;  // about 2 cm at the ends
+  qv_instance_set_state(s, q.data(), nullptr, nullptr);
+  double kinetic = 0, elastic = 0, start = 0;
+  qv_instance_energies(s, &kinetic, &elastic);
+  start = elastic;
+  int fellAsleepAt = -1;
+  for (int i = 0; i < 600 && fellAsleepAt < 0; ++i) {
+    qv_world_step(world.w);
+    if (qv_instance_asleep(s)) fellAsleepAt = i;
+  }
+  ASSERT_GE(fellAsleepAt, 0) << "still vibrating after 10 s";
+  qv_instance_energies(s, &kinetic, &elastic);
+  std::printf("a bar vibrating in space fell asleep after %.2f s, its elastic energy down to %.3g of the start\n",
+              (fellAsleepAt + 1) * h, elastic / start);
+  EXPECT_GT((fellAsleepAt + 1) * h, 1.0);
+  EXPECT_LT(elastic, 1e-3 * start);
+}
+
 TEST(World, BadUseIsRefused) {
   FreeBar bar;
   World world;
@@ -284,6 +465,17 @@ TEST(World, BadUseIsRefused) {
   qv_world* none = nullptr;
   EXPECT_EQ(qv_world_create(&c, nullptr, &none), QV_ERROR_INVALID_ARGUMENT);
   EXPECT_EQ(none, nullptr);
+  for (const double speed : {-1.0, std::nan(""), HUGE_VAL}) {
+    qv_world_config_init(&c);
+    c.sleep_speed = speed;
+    EXPECT_EQ(qv_world_create(&c, nullptr, &none), QV_ERROR_INVALID_ARGUMENT);
+    qv_world_config_init(&c);
+    c.sleep_time = speed;
+    EXPECT_EQ(qv_world_create(&c, nullptr, &none), QV_ERROR_INVALID_ARGUMENT);
+  }
+  EXPECT_EQ(qv_instance_asleep(flying.s), 0);
+  qv_instance_wake(nullptr);  // ignored
+  EXPECT_EQ(qv_instance_asleep(nullptr), 0);
 }
 
 } // namespace

@@ -390,13 +390,23 @@ QV_API int qv_instance_contacts(const qv_instance* instance, qv_contact* contact
    near it, carried by its frame; impulses on both frames and both deformations), then their moves and
    deformations. Contact between instances is vertex against surface: an edge crossing an edge with no
    vertex inside is not seen. The world keeps the instances by pointer; an instance's own colliders
-   (qv_instance_set_colliders) are not used in a world. No allocation in the step; deterministic. */
+   (qv_instance_set_colliders) are not used in a world. No allocation in the step; deterministic.
+   Sleeping: instances that could touch each other in a step (and those that could touch those) form a group;
+   a group all of whose instances have been slower than sleep_speed for sleep_time falls asleep: its
+   instances keep their pose and deformation, at rest, and are not stepped, and have no contacts, until
+   something wakes them: an awake instance or a moving collider (one with a velocity) coming within reach,
+   a force, gravity, state or pose given to one of them (qv_instance_add_vertex_force, ..._set_rigid_state),
+   qv_instance_wake, or qv_world_set_colliders (which wakes all). A collider moved without a velocity wakes
+   nothing: call qv_world_set_colliders again. */
 typedef struct qv_world qv_world;
 typedef struct qv_world_config {
   int max_instances;  /* default 64 */
   int max_contacts;   /* all the world's contacts in a step (more: each patch keeps a spread subset); default 4096 */
   double friction;    /* between instances: Coulomb mu, default 0.5 */
   double restitution; /* between instances: 0..1, default 0 */
+  double sleep_speed; /* m/s, >= 0: an instance is still while its frame's surface and its deformation's RMS speed
+                         together stay below this; 0: never sleep; default 0.02 */
+  double sleep_time;  /* s, >= 0: how long a group must be still to fall asleep; default 0.5 */
 } qv_world_config;
 QV_API void qv_world_config_init(qv_world_config* config);
 QV_API qv_result qv_world_create(const qv_world_config* config, const qv_allocator* allocator, qv_world** world);
@@ -404,10 +414,13 @@ QV_API void qv_world_destroy(qv_world* world);
 /* Adds a flying instance (QV_ERROR_INVALID_ARGUMENT: not flying, already in, its time step differs from the
    others', or the world is full); returns its index through `index` when not NULL. */
 QV_API qv_result qv_world_add(qv_world* world, qv_instance* instance, int* index);
-/* The world's colliders, kept by pointer as qv_instance_set_colliders keeps them. */
+/* The world's colliders, kept by pointer as qv_instance_set_colliders keeps them; wakes every instance. */
 QV_API qv_result qv_world_set_colliders(qv_world* world, const qv_collider* colliders, int count);
-/* Steps every instance once; returns how many reset (a blown-up state; never expected). */
+/* Steps every instance once (asleep: none); returns how many reset (a blown-up state; never expected). */
 QV_API int qv_world_step(qv_world* world);
+/* Whether an instance is asleep in its world (0 outside a world), and waking it (with the group it slept with). */
+QV_API int qv_instance_asleep(const qv_instance* instance);
+QV_API void qv_instance_wake(qv_instance* instance);
 /* The last world step's contacts, as qv_instance_contacts (instance and other say who touched whom; the
    impulse is on `instance`, its opposite on `other`). */
 QV_API int qv_world_contacts(const qv_world* world, qv_contact* contacts, int capacity);
