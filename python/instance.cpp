@@ -336,6 +336,9 @@ rest), the worst of the steps taken; last_step describes the last.)")
       .def("set_state", &setState, py::arg("q") = py::none(), py::arg("velocity") = py::none(), py::arg("acceleration") = py::none(),
            "Sets any of q, velocity, acceleration; without an acceleration, the one the equations of motion give there.")
       .def("reset", [](Instance& self) { qv_instance_reset(self.use()); }, "Back to rest (in flight: to the last rigid state set).")
+      .def_property_readonly("asleep", [](const Instance& self) { return qv_instance_asleep(self.raw()) != 0; },
+                             "Asleep in its World: not stepped until something wakes it.")
+      .def("wake", [](Instance& self) { qv_instance_wake(self.use()); }, "Wakes it (and the group it sleeps with) in its World.")
       .def("energies", [](const Instance& self) {
         double kinetic = 0, elastic = 0;
         qv_instance_energies(self.use(), &kinetic, &elastic);
@@ -456,25 +459,32 @@ StepStatus. Instances in a World are refused: the world steps them.)");
 
   py::class_<World>(m, "World", R"(Flying instances that touch each other and the world's colliders (qv_world).
 
-World(*, max_instances=64, max_contacts=4096, friction=0.5, restitution=0.0): friction and restitution
-between instances. add(instance) puts a flying instance in (all with the same time step); step()
-steps every instance once and returns how many reset. The world keeps its instances alive.)")
+World(*, max_instances=64, max_contacts=4096, friction=0.5, restitution=0.0, sleep_speed=0.02, sleep_time=0.5):
+friction and restitution between instances; a group of instances that could touch, all slower than sleep_speed
+(m/s; 0: never) for sleep_time (s), falls asleep until something wakes it (Instance.asleep, Instance.wake()).
+add(instance) puts a flying instance in (all with the same time step); step() steps every awake instance once
+and returns how many reset. The world keeps its instances alive.)")
       .def(py::init([](std::optional<int> maxInstances, std::optional<int> maxContacts, std::optional<double> friction,
-                       std::optional<double> restitution) {
+                       std::optional<double> restitution, std::optional<double> sleepSpeed, std::optional<double> sleepTime) {
              qv_world_config c;
              qv_world_config_init(&c);
              c.max_instances = maxInstances.value_or(c.max_instances);
              c.max_contacts = maxContacts.value_or(c.max_contacts);
              c.friction = friction.value_or(c.friction);
              c.restitution = restitution.value_or(c.restitution);
+             c.sleep_speed = sleepSpeed.value_or(c.sleep_speed);
+             c.sleep_time = sleepTime.value_or(c.sleep_time);
              require(c.max_instances >= 1 && c.max_instances <= 65536, "max_instances must be between 1 and 65536");
              require(c.max_contacts >= 0 && c.max_contacts <= (1 << 20), "max_contacts must be between 0 and 1048576");
              require(c.friction >= 0 && std::isfinite(c.friction), "friction must be >= 0 and finite");
              require(c.restitution >= 0 && c.restitution <= 1, "restitution must be between 0 and 1");
+             require(c.sleep_speed >= 0 && std::isfinite(c.sleep_speed), "sleep_speed must be >= 0 and finite");
+             require(c.sleep_time >= 0 && std::isfinite(c.sleep_time), "sleep_time must be >= 0 and finite");
              return std::make_unique<World>(c);
            }),
            py::kw_only(), py::arg("max_instances") = py::none(), py::arg("max_contacts") = py::none(),
-           py::arg("friction") = py::none(), py::arg("restitution") = py::none())
+           py::arg("friction") = py::none(), py::arg("restitution") = py::none(), py::arg("sleep_speed") = py::none(),
+           py::arg("sleep_time") = py::none())
       .def("add", [](World& self, py::object instance) {
         if (!py::isinstance<Instance>(instance)) throw py::type_error("World.add takes a quiver.Instance");
         Instance& s = instance.cast<Instance&>();

@@ -96,11 +96,18 @@ def test_a_world_stacks_one_beam_on_another(free_model):
     low, high = flyer(free_model, 0.06), flyer(free_model, 0.25)
     assert (world.add(low), world.add(high)) == (0, 1) and len(world) == 2
     world.set_colliders([quiver.Plane((0, 0, 1), 0.0)])
-    for _ in range(180):
+    for _ in range(600):
         assert world.step() == 0
-    # The lower rests on the ground, the upper on the lower (0.1 m thick), neither through.
+        if low.asleep and high.asleep:
+            break
+    # The lower rests on the ground, the upper on the lower (0.1 m thick), neither through; at rest
+    # they sleep, without contacts from the next step on, until one is woken, which wakes the other
+    # it rests on.
+    assert low.asleep and high.asleep and world.step() == 0 and len(world.contacts()) == 0
     assert -0.01 < low.positions()[:, 2].min() < 0.005
     assert high.rigid_state.position[2] == pytest.approx(0.15, abs=0.02)
+    high.wake()
+    assert world.step() == 0 and not low.asleep and not high.asleep
     contacts = world.contacts()
     between = contacts[contacts["other"] >= 0]
     assert len(between) > 0 and set(between["instance"]) <= {0, 1}
@@ -117,6 +124,8 @@ def test_a_world_stacks_one_beam_on_another(free_model):
         world.add(quiver.Instance(free_model, free_flight=True, time_step=0.01))
     with pytest.raises(ValueError, match="restitution"):
         quiver.World(restitution=2)
+    with pytest.raises(ValueError, match="sleep_speed"):
+        quiver.World(sleep_speed=-1)
 
 
 def test_colliders_check_their_shape(free_model):
