@@ -53,6 +53,7 @@ int simulateModel(const std::string& path, const SimOptions& o) {
         j["bodies"] = bodies.bodyCount();
         j["final_centers"] = centres;
         j["max_final_speed_mps"] = fastest;
+        j["asleep_at_end"] = bodies.asleepCount();
       }
     }
     std::cout << j.dump(1) << "\n";

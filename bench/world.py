@@ -1,8 +1,10 @@
 #!/usr/bin/python3
 """Worlds of free bodies in contact: N soft bars dropped in layers of four onto the ground and onto
 each other (`quiver sim --free --gravity --pile N`), one world step each frame on one thread, the
-median and 99th percentile of its wall time over 10 simulated seconds at 60 Hz. Bakes the bar
-(0.6 x 0.1 x 0.1 m, E = 1 MPa, no fixed vertex, 10 modes and their derivatives, r = 16) on 2 ranks.
+median and 99th percentile of its wall time over 10 simulated seconds at 60 Hz, with sleeping off
+(`--sleep-speed 0`: every body stepped and its contacts solved to the end) and on (the default: the
+groups that have come to rest sleep). Bakes the bar (0.6 x 0.1 x 0.1 m, E = 1 MPa, no fixed vertex,
+10 modes and their derivatives, r = 16) on 2 ranks.
 
     /usr/bin/python3 bench/world.py --build build/release [--piles 20,80,320]
 """
@@ -32,19 +34,22 @@ def main():
         subprocess.run(["mpirun", "-n", "2", os.path.join(apps, "quiver-bake"), mesh, "--modes", "10", "--rank", "16",
                         "--quiet", "-o", bar], check=True, env=ENV, stdin=subprocess.DEVNULL, capture_output=True)
         for n in (int(x) for x in args.piles.split(",")):
-            sim = subprocess.run([os.path.join(apps, "quiver"), "sim", bar + ".qvr", "--free", "--gravity", "--pile", str(n),
-                                  "--position", "0,0,0.2", "--collider", "plane:0,0,1,0", "--steps", str(STEPS), "--json"],
-                                 capture_output=True, text=True, stdin=subprocess.DEVNULL)
-            if sim.returncode not in (0, 2):  # 2: some step reset, which the table counts
-                raise SystemExit(f"quiver sim --pile {n} failed ({sim.returncode}): {sim.stderr.strip()}")
-            rows.append((n, json.loads(sim.stdout)))
+            for sleep in ("0", "0.02"):
+                sim = subprocess.run([os.path.join(apps, "quiver"), "sim", bar + ".qvr", "--free", "--gravity", "--pile", str(n),
+                                      "--position", "0,0,0.2", "--collider", "plane:0,0,1,0", "--steps", str(STEPS),
+                                      "--sleep-speed", sleep, "--json"],
+                                     capture_output=True, text=True, stdin=subprocess.DEVNULL)
+                if sim.returncode not in (0, 2):  # 2: some step reset, which the table counts
+                    raise SystemExit(f"quiver sim --pile {n} failed ({sim.returncode}): {sim.stderr.strip()}")
+                rows.append((n, "off" if sleep == "0" else f"{sleep} m/s", json.loads(sim.stdout)))
     print(machine_line() + f"; one thread, {STEPS} steps of 1/60 s\n")
-    print("| bodies | world step, median (ms) | 99th percentile (ms) | median per body (us) | fastest body at the end (m/s) "
-          "| deepest deformed-vertex penetration (mm) | resets |")
-    print("|---:|---:|---:|---:|---:|---:|---:|")
-    for n, j in rows:
-        print(f"| {n} | {j['step_us_median'] / 1e3:.2f} | {j['step_us_p99'] / 1e3:.1f} | {j['step_us_median'] / n:.0f} "
-              f"| {j.get('max_final_speed_mps', j['final_speed_mps']):.1g} | {j['max_penetration_m'] * 1e3:.0f} | {j['resets']} |")
+    print("| bodies | sleeping | world step, median (ms) | 99th percentile (ms) | median per body (us) | asleep at the end "
+          "| fastest body at the end (m/s) | deepest deformed-vertex penetration (mm) | resets |")
+    print("|---:|---|---:|---:|---:|---:|---:|---:|---:|")
+    for n, sleep, j in rows:
+        print(f"| {n} | {sleep} | {j['step_us_median'] / 1e3:.2f} | {j['step_us_p99'] / 1e3:.1f} | {j['step_us_median'] / n:.0f} "
+              f"| {j.get('asleep_at_end', 0)} | {j.get('max_final_speed_mps', j['final_speed_mps']):.1g} "
+              f"| {j['max_penetration_m'] * 1e3:.0f} | {j['resets']} |")
 
 
 if __name__ == "__main__":

@@ -45,6 +45,11 @@ void FlightSetup::addTo(CLI::App& app) {
   app.add_option("--restitution", restitution, "Free flight: restitution of the colliders, 0..1")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--sleep-speed", sleepSpeed,
+                 "Free flight, --pile: bodies that could touch, all slower than this (m/s) for half a second, sleep "
+                 "until something wakes them; 0: never")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--angular-velocity", angularVelocity, "Free flight: initial spin wx,wy,wz, rad/s (world axes)")
       ->delimiter(',')->expected(3);
 }
@@ -58,6 +63,7 @@ FlightWorld::FlightWorld(const RuntimeModel& model, const RuntimeInstance& first
     config.max_contacts = 64 * count;
     config.friction = o.friction;
     config.restitution = o.restitution;
+    config.sleep_speed = o.sleepSpeed;
     qv_world* world = nullptr;
     if (qv_world_create(&config, nullptr, &world) != QV_OK) throw std::runtime_error("--pile: out of memory");
     world_.reset(world);
@@ -100,6 +106,12 @@ void FlightWorld::setGravity(const double g[3]) {
 int FlightWorld::step() {
   if (world_) return qv_world_step(world_.get());
   return qv_instance_step(first_.get()) == QV_STEP_RESET ? 1 : 0;
+}
+
+int FlightWorld::asleepCount() const {
+  int asleep = 0;
+  for (int k = 0; k < bodyCount(); ++k) asleep += qv_instance_asleep(body(k).get());
+  return asleep;
 }
 
 const std::vector<qv_contact>& FlightWorld::contacts() {

@@ -21,8 +21,9 @@ struct FlightSetup {
   int pile = 1;                                  // --pile N: N copies in one world, touching each other
   double friction = 0.5;                         // Coulomb mu of every collider (and between bodies)
   double restitution = 0.2;                      // of every collider (and between bodies), 0..1
+  double sleepSpeed = 0.02;                      // --pile: qv_world_config.sleep_speed, m/s (0: never)
 
-  // --position, --velocity, --angular-velocity, --collider, --pile, --friction, --restitution.
+  // --position, --velocity, --angular-velocity, --collider, --pile, --friction, --restitution, --sleep-speed.
   void addTo(CLI::App& app);
 };
 
@@ -37,6 +38,7 @@ public:
   int bodyCount() const { return 1 + static_cast<int>(copies_.size()); }
   const RuntimeInstance& body(int k) const { return k == 0 ? first_ : *copies_[static_cast<size_t>(k - 1)]; }
   const ColliderSet& colliders() const { return colliders_; }
+  int asleepCount() const;
   void setGravity(const double acceleration[3]);
   // One step of every body; the number that reset.
   int step();
