@@ -322,7 +322,7 @@ void spreadSpeeds(ContactBody* bodies, int count, const qv_collider* colliders, 
   for (int i = 0; i < count; ++i) {
     ContactBody& b = bodies[i];
     const qv_instance& s = *b.instance;
-    b.group = i, b.touchSpeed = 0, b.ownSpeed = relativeSpeed(b, still);
+    b.group = i, b.touchSpeed = 0, b.ownSpeed = relativeSpeed(b, still), b.nearMovingCollider = false;
     for (int k = 0; k < colliderCount; ++k) {
       double u[3], distance, normal[3];
       surfaceVelocity(colliders[k], s.frame.position, u);
@@ -330,8 +330,10 @@ void spreadSpeeds(ContactBody* bodies, int count, const qv_collider* colliders, 
       const double speed = relativeSpeed(b, u) + norm3(colliders[k].angular_velocity) * s.surfaceRadius;
       if (!(speed > 0)) continue;  // adds nothing (a sleeper beside a still collider: no query)
       const double reach = s.surfaceRadius + s.contactSlop + 2 * h * speed;
-      if (colliderDistance(colliders[k], s.frame.position, reach, distance, normal) && distance <= reach)
-        b.touchSpeed = std::fmax(b.touchSpeed, speed);
+      if (!colliderDistance(colliders[k], s.frame.position, reach, distance, normal) || distance > reach) continue;
+      b.touchSpeed = std::fmax(b.touchSpeed, speed);
+      b.nearMovingCollider |= dot3(colliders[k].velocity, colliders[k].velocity) > 0 ||
+                              dot3(colliders[k].angular_velocity, colliders[k].angular_velocity) > 0;
     }
   }
   for (int i = 0; i < count; ++i)
@@ -561,8 +563,7 @@ int wakeSleepers(ContactBody* bodies, int count, const qv_collider* colliders, i
   for (int i = 0; i < count; ++i) bodies[i].wakes = false;
   for (int i = 0; i < count; ++i) {
     const bool asleep = bodies[i].instance->asleep;
-    // A sleeper's speeds are zero: any it has to something is a moving collider's.
-    if (!asleep || bodies[i].touchSpeed > 0) bodies[bodies[i].group].wakes = true;
+    if (!asleep || bodies[i].nearMovingCollider) bodies[bodies[i].group].wakes = true;
     if (asleep) continue;
     // Beyond its group: its margins grow with its group's speed (a sleeper's never exceed an
     // awake body's, so this side decides).
@@ -572,7 +573,11 @@ int wakeSleepers(ContactBody* bodies, int count, const qv_collider* colliders, i
   }
   int woken = 0;
   for (int i = 0; i < count; ++i)
-    if (bodies[i].instance->asleep && bodies[bodies[i].group].wakes) bodies[i].instance->wake(), ++woken;
+    if (bodies[i].instance->asleep && bodies[bodies[i].group].wakes) {
+      bodies[i].instance->wake();
+      bodies[i].instance->sleepGroup = -1;  // its whole sleep group is in its group, woken with it
+      ++woken;
+    }
   return woken;
 }
 

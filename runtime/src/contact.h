@@ -42,6 +42,7 @@ struct ContactBody {
   int group = 0;
   double ownSpeed = 0, touchSpeed = 0, groupSpeed = 0;
   bool wakes = false;
+  bool nearMovingCollider = false;  // one with a velocity is within its reach
 };
 
 // Friction and restitution between two instances (a collider brings its own).

@@ -97,9 +97,11 @@ struct qv_instance {
   double surfaceRadius = 0;        // m: the farthest surface vertex from the centre of mass, at rest
   double contactSlop = 0;          // m: penetration left alone
   // In a world (world.h): asleep, not stepped until woken; still for stillTime s (slower than its
-  // sleep speed). Whatever the caller changes wakes it (api.cpp).
+  // sleep speed); sleepGroup: the group it fell asleep with (-1: none), which it wakes with.
+  // Whatever the caller changes wakes it (api.cpp).
   bool asleep = false;
   double stillTime = 0;
+  int sleepGroup = -1;
   double* startQ = nullptr;  // in flight: q at a world step's start, to measure how far it moved q
 
   void carve(quiver::rt::BlockCarver& c);

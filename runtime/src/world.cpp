@@ -22,13 +22,19 @@ double stillSpeed(const qv_instance& s, double h) {
          std::hypot(omega[0], omega[1], omega[2]) * s.surfaceRadius + std::sqrt(dq2 / s.model->info.total_mass) / h;
 }
 
-// At rest where it is: its pose and deformation kept, its velocities zero.
-void fallAsleep(qv_instance& s) {
+// At rest where it is, in `group`: its pose and deformation kept, its velocities and acceleration
+// zero, and no spin change or lost energy for the next step to make up when it wakes.
+void fallAsleep(qv_instance& s, int group) {
   s.asleep = true;
+  s.sleepGroup = group;
   std::memset(s.v, 0, sizeof(double) * s.r);
-  std::memset(s.frame.velocity, 0, sizeof s.frame.velocity);
-  std::memset(s.frame.angularMomentum, 0, sizeof s.frame.angularMomentum);
-  s.frame.refresh(*s.model, s.q, s.v);
+  std::memset(s.a, 0, sizeof(double) * s.r);
+  s.energySlack = 0;
+  RigidFrame& f = s.frame;
+  std::memset(f.velocity, 0, sizeof f.velocity);
+  std::memset(f.angularMomentum, 0, sizeof f.angularMomentum);
+  f.refresh(*s.model, s.q, s.v);
+  std::memcpy(f.lastBodyOmega, f.bodyOmega, sizeof f.lastBodyOmega);
 }
 
 // Measures (block null) or places the world's arrays; returns the block's size.
@@ -94,23 +100,40 @@ void destroyWorld(qv_world* world) {
 int qv_world::step() {
   if (!count) return 0;
   const double h = instances[0]->config.time_step;
-  for (int i = 0; i < count; ++i) {
-    bodies[i].instance = instances[i];
-    if (!instances[i]->asleep) begin(i);
-  }
+  for (int i = 0; i < count; ++i) bodies[i].instance = instances[i];
+  wakeSleptWith();
+  int awake = 0;
+  for (int i = 0; i < count; ++i)
+    if (!instances[i]->asleep) begin(i), ++awake;
   // Woken bodies start their step and may reach other sleepers in it.
-  bool sleepers = false;
-  for (int i = 0; i < count; ++i) sleepers |= instances[i]->asleep;
-  while (sleepers && quiver::rt::wakeSleepers(bodies, count, colliders, colliderCount, h))
+  while (awake < count && quiver::rt::wakeSleepers(bodies, count, colliders, colliderCount, h))
     for (int i = 0; i < count; ++i)
-      if (!instances[i]->asleep && !slots[i].begun) begin(i);
+      if (!instances[i]->asleep && !slots[i].begun) begin(i), ++awake;
   const quiver::rt::ContactMaterial between{config.friction, config.restitution};
-  quiver::rt::solveContacts(bodies, count, colliders, colliderCount, between, contacts, h);
+  if (awake) {
+    quiver::rt::solveContacts(bodies, count, colliders, colliderCount, between, contacts, h);
+  } else {
+    contacts.clear();
+  }
   int resets = 0;
   for (int i = 0; i < count; ++i)
     if (!instances[i]->asleep) resets += instances[i]->finishStep() == QV_STEP_RESET;
   settle(h);
   return resets;
+}
+
+void qv_world::wakeSleptWith() {
+  // The caller woke these (and may have moved them away from the rest of their group): the
+  // bodies they fell asleep with wake too (a stack whose lowest is taken away must fall). A
+  // group's id is its root's index when it fell asleep: no sleeper keeps an id once its root woke
+  // (the world wakes whole groups, which hold the sleepers they fell asleep with, as sleepers do
+  // not move; here, whole sleep groups).
+  for (int i = 0; i < count; ++i) {
+    const int group = instances[i]->sleepGroup;
+    if (instances[i]->asleep || group < 0) continue;
+    for (int j = 0; j < count; ++j)
+      if (instances[j]->sleepGroup == group) instances[j]->wake(), instances[j]->sleepGroup = -1;
+  }
 }
 
 void qv_world::begin(int i) {
@@ -125,15 +148,19 @@ void qv_world::settle(double h) {
   for (int i = 0; i < count; ++i) slots[i].begun = false;
   if (!(config.sleep_speed > 0)) return;
   // Each group's shortest still time, at its root (the solve's groups: a group is all awake or all
-  // asleep), then the groups still long enough fall asleep together.
+  // asleep), then the groups still long enough (at least a step) fall asleep together; not beside
+  // a moving collider, which would wake them at once.
   for (int i = 0; i < count; ++i) slots[i].groupStill = INFINITY;
   for (int i = 0; i < count; ++i) {
     qv_instance& s = *instances[i];
     if (s.asleep) continue;
     s.stillTime = quiver::rt::stillSpeed(s, h) < config.sleep_speed ? s.stillTime + h : 0;
     double& least = slots[bodies[i].group].groupStill;
-    least = std::fmin(least, s.stillTime);
+    least = bodies[i].nearMovingCollider ? 0 : std::fmin(least, s.stillTime);
   }
-  for (int i = 0; i < count; ++i)
-    if (!instances[i]->asleep && slots[bodies[i].group].groupStill >= config.sleep_time) quiver::rt::fallAsleep(*instances[i]);
+  for (int i = 0; i < count; ++i) {
+    const double still = slots[bodies[i].group].groupStill;
+    if (!instances[i]->asleep && still > 0 && still >= config.sleep_time)
+      quiver::rt::fallAsleep(*instances[i], bodies[i].group);
+  }
 }

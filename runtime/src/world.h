@@ -28,6 +28,7 @@ struct qv_world {
   // Each awake instance's frame forces, one contact solve over all, then each move and deformation;
   // then the groups that have been still long enough fall asleep.
   int step();
+  void wakeSleptWith();
   void begin(int i);
   void settle(double h);
 };

@@ -5,7 +5,8 @@
 // other when the lowest lands, and bars laid edge on edge stay level; a pile of 20 dropped bars
 // comes to rest. Sleeping: a settled pile falls asleep where it rested (as the same pile awake
 // rests) and does not move; a bar dropped on a sleeping stack, a platform starting to move, a
-// push, new gravity and a ground taken away wake it; a vibrating bar does not fall asleep.
+// push, new gravity and a ground taken away wake it, and pulling the lowest from a sleeping stack
+// lets the one above fall; nothing sleeps while it falls or vibrates, or beside a moving collider.
 // Bad use is refused.
 #include <gtest/gtest.h>
 
@@ -270,7 +271,7 @@ TEST(World, APileOfTwentyDroppedBarsComesToRest) {
   EXPECT_LT(deepest, 0.008);
 }
 
-constexpr double kSleepSpeed = 0.02;  // qv_world_config's default
+constexpr double kSleepSpeed = 0.02;  // m/s
 
 Eigen::Vector3d centre(qv_instance* s) {
   qv_rigid_state state;
@@ -415,6 +416,80 @@ TEST(World, APushNewGravityOrAGroundTakenAwayWakesASleeper) {
   for (int i = 0; i < 30; ++i) qv_world_step(world.w);
   std::printf("pushed, gravity up and the ground taken away, the sleeping bar moved; fell to %.3f m\n", centre(s).z());
   EXPECT_LT(centre(s).z(), z0 - 0.5 * kG * 0.25 * 0.9);  // half a second of free fall
+}
+
+// The caller moves the lowest of a sleeping stack of two away: the one above must fall, not hang
+// asleep in the air (moving it wakes only it, and it is no longer near the one above).
+TEST(World, TheLowestPulledFromASleepingStackLetsTheOneAboveFall) {
+  FreeBar bar(16, {12, 2, 2});
+  const double h = 1.0 / 60;
+  World world(0.5, 0, 4096, kSleepSpeed);
+  world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0)};
+  world.setColliders();
+  qv_rigid_state turned = at(0.3, 0.05, 0.155);
+  turned.orientation[0] = turned.orientation[3] = std::sqrt(0.5);
+  qv_instance* lower = world.add(bar, h, at(0.3, 0.05, 0.052), true);
+  qv_instance* upper = world.add(bar, h, turned, true);
+  for (int i = 0; i < 120 && asleep(world) < 2; ++i) ASSERT_EQ(qv_world_step(world.w), 0);
+  ASSERT_EQ(asleep(world), 2);
+  const qv_rigid_state aside = at(3, 0.05, 0.052);
+  EXPECT_EQ(qv_instance_set_rigid_state(lower, &aside), QV_OK);
+  for (int i = 0; i < 60; ++i) ASSERT_EQ(qv_world_step(world.w), 0);
+  std::printf("the lowest of a sleeping stack pulled away: the upper fell from 0.15 to %.4f m\n", centre(upper).z());
+  EXPECT_NEAR(centre(upper).z(), 0.05, 0.005);  // on the ground
+}
+
+// Asleep after a single still step (sleep_time 0), but never while falling.
+TEST(World, WithNoSleepTimeABarSleepsOnlyOnceItIsStill) {
+  FreeBar bar(16, {12, 2, 2});
+  const double h = 1.0 / 60;
+  qv_world_config c;
+  qv_world_config_init(&c);
+  c.sleep_time = 0;
+  World world(0.5, 0, 4096, kSleepSpeed);
+  qv_world_destroy(world.w);
+  ASSERT_EQ(qv_world_create(&c, nullptr, &world.w), QV_OK);
+  world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0)};
+  world.setColliders();
+  qv_instance* s = world.add(bar, h, at(0.3, 0.05, 0.5), true);
+  int fellAsleepAt = -1;
+  for (int i = 0; i < 120 && fellAsleepAt < 0; ++i) {
+    ASSERT_EQ(qv_world_step(world.w), 0);
+    if (qv_instance_asleep(s)) fellAsleepAt = i;
+  }
+  std::printf("with no sleep time, a bar dropped from 0.45 m fell asleep after %.3f s at %.4f m\n", (fellAsleepAt + 1) * h,
+              centre(s).z());
+  ASSERT_GE(fellAsleepAt, 0);
+  EXPECT_NEAR(centre(s).z(), 0.05, 0.005);  // on the ground, not in the air
+}
+
+// A still bar beside a kinematic ball that spins within its reach, not touching it: it would be
+// woken at once, so it stays awake (it fell asleep and woke every half second, restarting its
+// contacts' impulses each time); once the ball stops it sleeps.
+TEST(World, AStillBarBesideAMovingColliderStaysAwake) {
+  FreeBar bar(16, {12, 2, 2});
+  const double h = 1.0 / 60;
+  World world(0.5, 0, 4096, kSleepSpeed);
+  world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0),
+                     makeCollider(QV_COLLIDER_SPHERE, {0.7, 0.05, 0.1, 0.05, 0, 0, 0, 0}, 0.5, 0)};
+  world.colliders[1].angular_velocity[2] = 3;
+  world.setColliders();
+  qv_instance* s = world.add(bar, h, at(0.3, 0.05, 0.052), true);
+  int asleepSteps = 0;
+  for (int i = 0; i < 120; ++i) {
+    ASSERT_EQ(qv_world_step(world.w), 0);
+    asleepSteps += qv_instance_asleep(s);
+  }
+  world.colliders[1].angular_velocity[2] = 0;
+  bool sleepsOnceStopped = false;
+  for (int i = 0; i < 60; ++i) {
+    ASSERT_EQ(qv_world_step(world.w), 0);
+    sleepsOnceStopped |= qv_instance_asleep(s) != 0;
+  }
+  std::printf("beside a spinning ball: asleep in %d of 120 steps; asleep once it stopped: %s\n", asleepSteps,
+              sleepsOnceStopped ? "yes" : "no");
+  EXPECT_EQ(asleepSteps, 0);
+  EXPECT_TRUE(sleepsOnceStopped);
 }
 
 // In space, still but vibrating (its first mode bent, lightly damped): it must not fall asleep
