@@ -16,7 +16,7 @@ extern "C" {
 #endif
 
 #define QV_VERSION_MAJOR 0
-#define QV_VERSION_MINOR 9
+#define QV_VERSION_MINOR 10
 #define QV_VERSION_PATCH 0
 #define QV_VERSION_NUMBER (QV_VERSION_MAJOR * 10000 + QV_VERSION_MINOR * 100 + QV_VERSION_PATCH)
 
@@ -392,20 +392,21 @@ QV_API int qv_instance_contacts(const qv_instance* instance, qv_contact* contact
    vertex inside is not seen. The world keeps the instances by pointer; an instance's own colliders
    (qv_instance_set_colliders) are not used in a world. No allocation in the step; deterministic.
    Sleeping: instances that could touch each other in a step (and those that could touch those) form a group;
-   a group all of whose instances have been slower than sleep_speed for sleep_time falls asleep: its
-   instances keep their pose and deformation, at rest, and are not stepped, and have no contacts, until
-   something wakes them: an awake instance or a moving collider (one with a velocity) coming within reach,
-   a force, gravity, state or pose given to one of them (qv_instance_add_vertex_force, ..._set_rigid_state),
-   qv_instance_wake, or qv_world_set_colliders (which wakes all). A collider moved without a velocity wakes
-   nothing: call qv_world_set_colliders again. */
+   a group all of whose instances have been slower than sleep_speed for sleep_time (and at least a step),
+   with no moving collider (one with a velocity) within reach, falls asleep: its instances keep their pose
+   and deformation, at rest, and are not stepped, and have no contacts from the next step on, until
+   something wakes them: an awake instance or a moving collider coming within reach, or the caller giving
+   one of them a force, other gravity, a state, a pose (qv_instance_add_vertex_force, ..._set_rigid_state,
+   ...) or qv_instance_wake, which wakes the whole group it fell asleep with, or qv_world_set_colliders
+   (which wakes all). A collider moved without a velocity wakes nothing: call qv_world_set_colliders again. */
 typedef struct qv_world qv_world;
 typedef struct qv_world_config {
   int max_instances;  /* default 64 */
   int max_contacts;   /* all the world's contacts in a step (more: each patch keeps a spread subset); default 4096 */
   double friction;    /* between instances: Coulomb mu, default 0.5 */
   double restitution; /* between instances: 0..1, default 0 */
-  double sleep_speed; /* m/s, >= 0: an instance is still while its frame's surface and its deformation's RMS speed
-                         together stay below this; 0: never sleep; default 0.02 */
+  double sleep_speed; /* m/s, >= 0: an instance is still while its frame's surface speed and its deformation's RMS
+                         speed over the step together stay below this; 0: never sleep; default 0.02 */
   double sleep_time;  /* s, >= 0: how long a group must be still to fall asleep; default 0.5 */
 } qv_world_config;
 QV_API void qv_world_config_init(qv_world_config* config);
