@@ -336,7 +336,7 @@ rest), the worst of the steps taken; last_step describes the last.)")
       .def("set_state", &setState, py::arg("q") = py::none(), py::arg("velocity") = py::none(), py::arg("acceleration") = py::none(),
            "Sets any of q, velocity, acceleration; without an acceleration, the one the equations of motion give there.")
       .def("reset", [](Instance& self) { qv_instance_reset(self.use()); }, "Back to rest (in flight: to the last rigid state set).")
-      .def_property_readonly("asleep", [](const Instance& self) { return qv_instance_asleep(self.raw()) != 0; },
+      .def_property_readonly("asleep", [](const Instance& self) { return qv_instance_asleep(self.use()) != 0; },
                              "Asleep in its World: not stepped until something wakes it.")
       .def("wake", [](Instance& self) { qv_instance_wake(self.use()); }, "Wakes it (and the group it sleeps with) in its World.")
       .def("energies", [](const Instance& self) {
@@ -524,7 +524,7 @@ and returns how many reset. The world keeps its instances alive.)")
         self.busy = true;
         py::gil_scoped_release release;
         return qv_world_step(world);
-      }, "Steps every instance once; returns how many reset (never expected).")
+      }, "Steps every awake instance once; returns how many reset (never expected).")
       .def("contacts", [](const World& self) { return contactArray(static_cast<const qv_world*>(self.use()), qv_world_contacts); },
            "The last step's contacts, as Instance.contacts(); `instance` and `other` say who touched whom.");
 }

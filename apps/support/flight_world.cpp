@@ -28,6 +28,12 @@ void pileSlot(const qv_model_info& info, int k, int count, double offset[3], dou
 
 } // namespace
 
+FlightSetup::FlightSetup() {
+  qv_world_config world;
+  qv_world_config_init(&world);
+  sleepSpeed = world.sleep_speed;
+}
+
 void FlightSetup::addTo(CLI::App& app) {
   app.add_option("--position", position, "Free flight: start translated by x,y,z (m) from where the model was baked")
       ->delimiter(',')->expected(3);

@@ -21,7 +21,9 @@ struct FlightSetup {
   int pile = 1;                                  // --pile N: N copies in one world, touching each other
   double friction = 0.5;                         // Coulomb mu of every collider (and between bodies)
   double restitution = 0.2;                      // of every collider (and between bodies), 0..1
-  double sleepSpeed = 0.02;                      // --pile: qv_world_config.sleep_speed, m/s (0: never)
+  double sleepSpeed = 0;                         // --pile: qv_world_config.sleep_speed, m/s (0: never); the runtime's default
+
+  FlightSetup();
 
   // --position, --velocity, --angular-velocity, --collider, --pile, --friction, --restitution, --sleep-speed.
   void addTo(CLI::App& app);

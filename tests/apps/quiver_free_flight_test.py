@@ -118,10 +118,14 @@ class FreeFlight(unittest.TestCase):
 
     def test_a_pile_of_twenty_comes_to_rest(self):
         walls = ["box:0,0.95,0.1,1,0.05,0.1", "box:0,-0.95,0.1,1,0.05,0.1", "box:0.95,0,0.1,0.05,1,0.1", "box:-0.95,0,0.1,0.05,1,0.1"]
-        p = run(QUIVER, "sim", self.free + ".qvr", "--free", "--gravity", "--pile", 20, "--position", "0,0,0.2",
-                "--collider", "plane:0,0,1,0", *[a for w in walls for a in ("--collider", w)], "--alpha", 5,
-                "--steps", 360, "--hold", 0, "--json")
-        j = json.loads(p.stdout)
+        pile = lambda *more: json.loads(run(QUIVER, "sim", self.free + ".qvr", "--free", "--gravity", "--pile", 20,
+                                            "--position", "0,0,0.2", "--collider", "plane:0,0,1,0",
+                                            *[a for w in walls for a in ("--collider", w)], "--alpha", 5, "--steps", 360,
+                                            "--hold", 0, "--json", *more).stdout)
+        # Kept awake, it comes to rest by itself; by default it falls asleep there.
+        j, sleeping = pile("--sleep-speed", 0), pile()
+        self.assertEqual((j["asleep_at_end"], sleeping["asleep_at_end"]), (0, 20))
+        self.assertLess(np.abs(np.array(j["final_centers"]) - np.array(sleeping["final_centers"])).max(), 0.002)
         heights = sorted(c[2] for c in j["final_centers"])
         print(f"pile of {j['bodies']}: fastest {j['max_final_speed_mps']:.2g} m/s after 6 s, centres {heights[0]:.3f} to "
               f"{heights[-1]:.3f} m high, deepest {j['max_penetration_m'] * 1000:.2g} mm, {j['step_us_median']:.0f} us a step")

@@ -141,8 +141,8 @@ class QuiverView(unittest.TestCase):
         print(f"landed at {centre}, held at {held}, thrown at {thrown} m/s, came down at {end}")
         self.assertGreater(np.linalg.norm(end[:2] - centre[:2]), 0.1, "it flew somewhere else")
         self.assertIn("0 resets", p.stdout)
-        # A pile of 8 is drawn and rests.
-        p = self.view("--free", "--pile", 8, "--frames", 150, "--no-panel", model=FREE_MODEL)
+        # A pile of 8 is drawn and rests (kept awake, so that it rests by itself).
+        p = self.view("--free", "--pile", 8, "--sleep-speed", 0, "--frames", 150, "--no-panel", model=FREE_MODEL)
         piled = self.bodies(p.stdout)
         self.assertEqual(len(piled), 8)
         self.assertLess(max(np.linalg.norm(v) for _, v in piled), 0.01)

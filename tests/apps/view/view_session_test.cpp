@@ -243,7 +243,9 @@ TEST_F(FreeViewSessionTest, ItDropsLiftsOnTheSpringAndFliesWhereItIsThrown) {
 }
 
 TEST_F(FreeViewSessionTest, APileIsDrawnAsAllItsBodiesAndComesToRest) {
-  ViewSession session(model, flying(), dropped(8));
+  FlightSetup awake = dropped(8);
+  awake.sleepSpeed = 0;  // it must come to rest by itself, not be put to sleep
+  ViewSession session(model, flying(), awake);
   ASSERT_EQ(session.bodyCount(), 8);
   const size_t n = static_cast<size_t>(model.info().vertex_count);
   std::vector<float> x, normals;
