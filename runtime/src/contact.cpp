@@ -306,6 +306,25 @@ double pairSpeed(const ContactBody& a, const ContactBody& b) {
   return relativeSpeed(a, b.velocity) + norm3(b.omega) * b.instance->surfaceRadius;
 }
 
+// The broad phase's intervals: each body's centre and a half width bounding its reach, `reach(b)`,
+// padded so that rounding cannot drop a pair the exact test would keep.
+template <class Reach>
+void sortByReach(const ContactBody* bodies, int count, BroadPhase& broad, Reach reach) {
+  for (int i = 0; i < count; ++i) {
+    const double* x = bodies[i].instance->frame.position;
+    std::memcpy(broad.centres + 3 * i, x, 3 * sizeof(double));
+    const double w = reach(bodies[i]);
+    broad.halfWidth[i] = w + 1e-9 * (w + std::fabs(x[0]) + std::fabs(x[1]) + std::fabs(x[2]));
+  }
+  sortIntervals(broad, count);
+}
+
+// How far body b's contacts with others can reach beyond its bounding sphere: its share of any
+// pair's margin (bodyMargin() <= the sum of both shares: a pair's speed is at most both speeds).
+double contactReach(const ContactBody& b, double h) {
+  return b.instance->surfaceRadius + b.instance->contactSlop + 2 * h * (b.ownSpeed + b.groupSpeed);
+}
+
 int groupOf(ContactBody* bodies, int i) {
   while (bodies[i].group != i) i = bodies[i].group = bodies[bodies[i].group].group;
   return i;
@@ -317,7 +336,8 @@ int groupOf(ContactBody* bodies, int i) {
 // the solve does to either: a pile's layers fell together, the ground stopped the lowest, and the
 // next fell 5 cm into it; one hit from above pushed the one below it into the ground. A group that
 // touches nothing moving otherwise (a pile falling together) keeps its margins.
-void spreadSpeeds(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h) {
+void spreadSpeeds(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h,
+                  BroadPhase* broad) {
   const double still[3] = {};
   for (int i = 0; i < count; ++i) {
     ContactBody& b = bodies[i];
@@ -336,20 +356,28 @@ void spreadSpeeds(ContactBody* bodies, int count, const qv_collider* colliders, 
                               dot3(colliders[k].angular_velocity, colliders[k].angular_velocity) > 0;
     }
   }
-  for (int i = 0; i < count; ++i)
-    for (int j = i + 1; j < count; ++j) {
-      const qv_instance &a = *bodies[i].instance, &b = *bodies[j].instance;
-      double gap[3];
-      for (int k = 0; k < 3; ++k) gap[k] = a.frame.position[k] - b.frame.position[k];
-      // Within reach if either stopped (their relative speed is never more than both speeds).
-      if (norm3(gap) > a.surfaceRadius + b.surfaceRadius + std::fmax(a.contactSlop, b.contactSlop) +
-                           2 * h * (bodies[i].ownSpeed + bodies[j].ownSpeed))
-        continue;
-      const double speed = pairSpeed(bodies[i], bodies[j]);
-      bodies[i].touchSpeed = std::fmax(bodies[i].touchSpeed, speed);
-      bodies[j].touchSpeed = std::fmax(bodies[j].touchSpeed, speed);
-      bodies[groupOf(bodies, i)].group = groupOf(bodies, j);
-    }
+  const auto pair = [&](int i, int j) {
+    const qv_instance &a = *bodies[i].instance, &b = *bodies[j].instance;
+    double gap[3];
+    for (int k = 0; k < 3; ++k) gap[k] = a.frame.position[k] - b.frame.position[k];
+    // Within reach if either stopped (their relative speed is never more than both speeds).
+    if (norm3(gap) > a.surfaceRadius + b.surfaceRadius + std::fmax(a.contactSlop, b.contactSlop) +
+                         2 * h * (bodies[i].ownSpeed + bodies[j].ownSpeed))
+      return;
+    const double speed = pairSpeed(bodies[i], bodies[j]);
+    bodies[i].touchSpeed = std::fmax(bodies[i].touchSpeed, speed);
+    bodies[j].touchSpeed = std::fmax(bodies[j].touchSpeed, speed);
+    bodies[groupOf(bodies, i)].group = groupOf(bodies, j);
+  };
+  if (broad) {
+    sortByReach(bodies, count, *broad, [&](const ContactBody& b) {
+      return b.instance->surfaceRadius + b.instance->contactSlop + 2 * h * b.ownSpeed;
+    });
+    forEachOverlap(*broad, pair);
+  } else {
+    for (int i = 0; i < count; ++i)
+      for (int j = i + 1; j < count; ++j) pair(i, j);
+  }
   for (int i = 0; i < count; ++i) bodies[i].groupSpeed = 0;
   for (int i = 0; i < count; ++i) {
     ContactBody& root = bodies[groupOf(bodies, i)];
@@ -376,7 +404,8 @@ bool withinMargin(const ContactBody* bodies, int i, int j, double margin) {
 }
 
 // The solve starts from the frames' momenta as their velocity updates left them.
-void takeMomenta(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h) {
+void takeMomenta(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h,
+                 BroadPhase* broad) {
   for (int i = 0; i < count; ++i) {
     ContactBody& b = bodies[i];
     const RigidFrame& f = b.instance->frame;
@@ -384,7 +413,7 @@ void takeMomenta(ContactBody* bodies, int count, const qv_collider* colliders, i
     std::memcpy(b.angularMomentum, f.angularMomentum, sizeof b.angularMomentum);
     f.worldOmega(b.omega);
   }
-  spreadSpeeds(bodies, count, colliders, colliderCount, h);
+  spreadSpeeds(bodies, count, colliders, colliderCount, h, broad);
 }
 
 // How far from a surface a candidate can be and still be kept: a full list takes only those its
@@ -558,18 +587,25 @@ bool colliderDistance(const qv_collider& c, const double p[3], double reach, dou
   return true;
 }
 
-int wakeSleepers(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h) {
-  takeMomenta(bodies, count, colliders, colliderCount, h);
+int wakeSleepers(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h,
+                 BroadPhase* broad) {
+  takeMomenta(bodies, count, colliders, colliderCount, h, broad);
   for (int i = 0; i < count; ++i) bodies[i].wakes = false;
-  for (int i = 0; i < count; ++i) {
-    const bool asleep = bodies[i].instance->asleep;
-    if (!asleep || bodies[i].nearMovingCollider) bodies[bodies[i].group].wakes = true;
-    if (asleep) continue;
-    // Beyond its group: its margins grow with its group's speed (a sleeper's never exceed an
-    // awake body's, so this side decides).
-    for (int j = 0; j < count; ++j)
-      if (bodies[j].instance->asleep && withinMargin(bodies, i, j, bodyMargin(bodies, i, j, h)))
-        bodies[bodies[j].group].wakes = true;
+  for (int i = 0; i < count; ++i)
+    if (!bodies[i].instance->asleep || bodies[i].nearMovingCollider) bodies[bodies[i].group].wakes = true;
+  // Beyond its group: an awake body's margins grow with its group's speed (a sleeper's never
+  // exceed an awake body's, so that side decides).
+  const auto pair = [&](int i, int j) {
+    if (bodies[i].instance->asleep == bodies[j].instance->asleep) return;
+    const int awake = bodies[i].instance->asleep ? j : i, sleeper = awake == i ? j : i;
+    if (withinMargin(bodies, awake, sleeper, bodyMargin(bodies, awake, sleeper, h))) bodies[bodies[sleeper].group].wakes = true;
+  };
+  if (broad) {
+    sortByReach(bodies, count, *broad, [&](const ContactBody& b) { return contactReach(b, h); });
+    forEachOverlap(*broad, pair);
+  } else {
+    for (int i = 0; i < count; ++i)
+      for (int j = i + 1; j < count; ++j) pair(i, j);
   }
   int woken = 0;
   for (int i = 0; i < count; ++i)
@@ -582,12 +618,19 @@ int wakeSleepers(ContactBody* bodies, int count, const qv_collider* colliders, i
 }
 
 void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* colliders, int colliderCount,
-                   const ContactMaterial& material, ContactList& list, double h) {
+                   const ContactMaterial& material, ContactList& list, double h, BroadPhase* broad) {
   std::swap(list.contacts, list.previous);
   list.previousCount = list.count;
   list.count = 0;
   list.full = false;
-  takeMomenta(bodies, bodyCount, colliders, colliderCount, h);
+  takeMomenta(bodies, bodyCount, colliders, colliderCount, h, broad);
+  // Each body's candidates in ascending order (as a scan of all would meet them: a full list's
+  // choice depends on the order it meets its candidates).
+  if (broad) {
+    sortByReach(bodies, bodyCount, *broad, [&](const ContactBody& b) { return contactReach(b, h); });
+    listOverlaps(*broad);
+  }
+  const bool rows = broad && broad->rowsValid;
   // Contacts: each surface vertex of the rest shape carried by the frame. Found and solved on the
   // rigid shape: the deformation takes the forces but does not move the contacts (taking its
   // vertices made the loads on q and the contacts chase each other: a resting bar fluttered, bent
@@ -597,8 +640,12 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
       if (!list.reducing) bodies[i].firstPair = bodies[i].pairEnd = list.pairCount;
       if (bodies[i].instance->asleep) continue;
       findColliderContacts(bodies, i, colliders, colliderCount, h, list);
-      for (int j = 0; j < bodyCount; ++j)
+      const int* others = rows ? broad->neighbours + broad->rowStart[i] : nullptr;
+      const int otherCount = rows ? broad->rowStart[i + 1] - broad->rowStart[i] : bodyCount;
+      for (int k = 0; k < otherCount; ++k) {
+        const int j = others ? others[k] : k;
         if (j != i && !bodies[j].instance->asleep) findBodyContacts(bodies, i, j, h, material, list);
+      }
     }
   };
   list.pairCount = list.touching = 0;

@@ -24,6 +24,7 @@
 //   lands and sags where it rests), a bounded load for the implicit step; less the bounce, which the
 //   restitution already returns to the frame (loading q with it too made a bounce gain 31%). The
 //   object touched takes the opposite force at its surface vertex nearest the contact.
+#include "broad_phase.h"
 #include "contact_list.h"
 #include "instance.h"
 
@@ -62,13 +63,15 @@ bool validCollider(const qv_collider& collider);
 // impulses into the frames' velocities and angular momenta, and adds their forces on q. Call after
 // the frames' velocity updates, before they move; all bodies share the time step h. Sleeping
 // bodies (qv_instance::asleep, at rest) take no part: none may be within an awake body's reach
-// (wakeSleepers()).
+// (wakeSleepers()). With `broad` (a world's), the pairs of bodies tested are its overlaps
+// (broad_phase.h); without, every pair.
 void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* colliders, int colliderCount,
-                   const ContactMaterial& between, ContactList& list, double h);
+                   const ContactMaterial& between, ContactList& list, double h, BroadPhase* broad = nullptr);
 
 // Wakes every sleeping body whose group (as the solve will group them) holds an awake body or
 // meets a moving collider, and every one within an awake body's margin; returns how many. Woken
 // bodies start their step and move, so call again until it wakes none.
-int wakeSleepers(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h);
+int wakeSleepers(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h,
+                 BroadPhase* broad = nullptr);
 
 } // namespace quiver::rt

@@ -44,6 +44,8 @@ size_t layOut(const qv_world_config& config, char* block, qv_world** world) {
   qv_instance** instances = c.take<qv_instance*>(static_cast<size_t>(config.max_instances));
   ContactBody* bodies = c.take<ContactBody>(static_cast<size_t>(config.max_instances));
   WorldSlot* slots = c.take<WorldSlot>(static_cast<size_t>(config.max_instances));
+  BroadPhase broad;
+  broad.carve(c, config.max_instances);
   Contact* contacts = c.take<Contact>(static_cast<size_t>(config.max_contacts));
   Contact* previous = c.take<Contact>(static_cast<size_t>(config.max_contacts));
   ContactPair* pairs = c.take<ContactPair>(static_cast<size_t>(config.max_contacts));
@@ -53,6 +55,7 @@ size_t layOut(const qv_world_config& config, char* block, qv_world** world) {
     w->instances = instances;
     w->bodies = new (bodies) ContactBody[config.max_instances];
     w->slots = new (slots) WorldSlot[config.max_instances];
+    w->broad = broad;
     w->contacts.contacts = contacts;
     w->contacts.previous = previous;
     w->contacts.pairs = pairs;
@@ -106,12 +109,12 @@ int qv_world::step() {
   for (int i = 0; i < count; ++i)
     if (!instances[i]->asleep) begin(i), ++awake;
   // Woken bodies start their step and may reach other sleepers in it.
-  while (awake < count && quiver::rt::wakeSleepers(bodies, count, colliders, colliderCount, h))
+  while (awake < count && quiver::rt::wakeSleepers(bodies, count, colliders, colliderCount, h, &broad))
     for (int i = 0; i < count; ++i)
       if (!instances[i]->asleep && !slots[i].begun) begin(i), ++awake;
   const quiver::rt::ContactMaterial between{config.friction, config.restitution};
   if (awake) {
-    quiver::rt::solveContacts(bodies, count, colliders, colliderCount, between, contacts, h);
+    quiver::rt::solveContacts(bodies, count, colliders, colliderCount, between, contacts, h, &broad);
   } else {
     contacts.clear();
   }

@@ -21,6 +21,7 @@ struct qv_world {
   int count = 0;
   quiver::rt::ContactBody* bodies = nullptr;
   quiver::rt::WorldSlot* slots = nullptr;
+  quiver::rt::BroadPhase broad;
   quiver::rt::ContactList contacts;
   const qv_collider* colliders = nullptr;  // the caller's (qv_world_set_colliders)
   int colliderCount = 0;
