@@ -10,13 +10,23 @@ namespace {
 
 // Where body k of `count` goes: layers of four on a 2 x 2 grid spaced by the model's width, each
 // layer turned a quarter about z from the one below and raised by 1.5 x the model's height, each
-// body turned a little more so that the pile does not stand in perfect columns. A single body stays.
-void pileSlot(const qv_model_info& info, int k, int count, double offset[3], double quaternion[4]) {
+// body turned a little more so that the pile does not stand in perfect columns. Spread: side by
+// side on a square grid, 1.2 x the model's diagonal apart (apart for good), each turned a little.
+// A single body stays.
+void pileSlot(const qv_model_info& info, int k, int count, bool spread, double offset[3], double quaternion[4]) {
   offset[0] = offset[1] = offset[2] = 0;
   quaternion[0] = 1, quaternion[1] = quaternion[2] = quaternion[3] = 0;
   if (count == 1) return;
   const double dx = info.bbox_max[0] - info.bbox_min[0], dy = info.bbox_max[1] - info.bbox_min[1],
                dz = info.bbox_max[2] - info.bbox_min[2];
+  if (spread) {
+    const int side = static_cast<int>(std::ceil(std::sqrt(count)));
+    const double spacing = 1.2 * std::sqrt(dx * dx + dy * dy + dz * dz), yaw = 0.15 * (k % 7);
+    offset[0] = (k % side - (side - 1) / 2.0) * spacing;
+    offset[1] = (k / side - (side - 1) / 2.0) * spacing;
+    quaternion[0] = std::cos(yaw / 2), quaternion[3] = std::sin(yaw / 2);
+    return;
+  }
   const double spacing = 0.6 * std::hypot(dx, dy);
   const int layer = k / 4, slot = k % 4;
   offset[0] = (slot == 1 || slot == 3 ? 1 : -1) * spacing;
@@ -51,6 +61,7 @@ void FlightSetup::addTo(CLI::App& app) {
   app.add_option("--restitution", restitution, "Free flight: restitution of the colliders, 0..1")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  app.add_flag("--spread", spread, "Free flight, --pile: the N copies side by side on a square grid, apart, not piled");
   app.add_option("--sleep-speed", sleepSpeed,
                  "Free flight, --pile: bodies that could touch, all slower than this (m/s) for half a second, sleep "
                  "until something wakes them; 0: never")
@@ -80,7 +91,7 @@ FlightWorld::FlightWorld(const RuntimeModel& model, const RuntimeInstance& first
     qv_rigid_state state;
     qv_instance_get_rigid_state(s, &state);  // the pose as baked
     double offset[3], turn[4];
-    pileSlot(model.info(), k, count, offset, turn);
+    pileSlot(model.info(), k, count, o.spread, offset, turn);
     for (int a = 0; a < 3; ++a) {  // turned about the baked centre of mass, then moved
       state.position[a] += o.position[a] + offset[a];
       state.linear_velocity[a] = o.velocity[a];

@@ -19,13 +19,15 @@ struct FlightSetup {
   std::vector<double> angularVelocity{0, 0, 0};  // rad/s, about the centre of mass
   std::vector<std::string> colliders;            // --collider TYPE:NUMBERS (ColliderSet::add)
   int pile = 1;                                  // --pile N: N copies in one world, touching each other
+  bool spread = false;                           // --spread: the copies side by side, apart
   double friction = 0.5;                         // Coulomb mu of every collider (and between bodies)
   double restitution = 0.2;                      // of every collider (and between bodies), 0..1
   double sleepSpeed = 0;                         // --pile: qv_world_config.sleep_speed, m/s (0: never); the runtime's default
 
   FlightSetup();
 
-  // --position, --velocity, --angular-velocity, --collider, --pile, --friction, --restitution, --sleep-speed.
+  // --position, --velocity, --angular-velocity, --collider, --pile, --spread, --friction, --restitution,
+  // --sleep-speed.
   void addTo(CLI::App& app);
 };
 

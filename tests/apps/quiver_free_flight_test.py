@@ -137,6 +137,18 @@ class FreeFlight(unittest.TestCase):
         for x, y, _ in j["final_centers"]:
             self.assertLess(max(abs(x), abs(y)), 0.9)  # inside the walls
 
+    def test_spread_bodies_rest_apart_and_sleep(self):
+        # --spread: nine bars on a 3 x 3 grid, each landing on its own spot and none touching another.
+        j = json.loads(run(QUIVER, "sim", self.free + ".qvr", "--free", "--gravity", "--pile", 9, "--spread",
+                           "--collider", "plane:0,0,1,0", "--steps", 120, "--hold", 0, "--json").stdout)
+        centres = np.array(j["final_centers"])
+        gaps = [np.linalg.norm(a[:2] - b[:2]) for i, a in enumerate(centres) for b in centres[i + 1:]]
+        print(f"nine spread: centres {min(gaps):.3f} m apart at least, heights {centres[:, 2].min():.4f} to "
+              f"{centres[:, 2].max():.4f} m, {j['asleep_at_end']} asleep")
+        self.assertGreater(min(gaps), 0.6)  # the bar is 0.6 m long: none on another
+        np.testing.assert_allclose(centres[:, 2], 0.05, atol=0.005)  # each on the ground
+        self.assertEqual(j["asleep_at_end"], 9)
+
     def test_a_pile_writes_every_body(self):
         # -o with --pile: one part per body in each frame, each where the JSON says its centre is.
         out = os.path.join(self.tmp.name, "pile", "three")
