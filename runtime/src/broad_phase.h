@@ -3,9 +3,9 @@
 // reach of each other in a step, so that the exact tests (bounding spheres within reach) run on
 // those alone rather than on all N^2 pairs. Each body is an interval along one axis, its centre
 // plus and minus a half width that bounds its reach (bounding sphere, slop, and what it and its
-// group cover in the step). Two bodies whose intervals do not overlap cannot be within reach: their
-// distance is at least their centres' distance along any axis. A sort along the axis on which the
-// centres spread most, then a sweep. The caller's memory; no allocation.
+// group cover in the step; not NaN). Two bodies whose intervals do not overlap cannot be within
+// reach: their centres' distance is at least its part along any axis. A sort along the axis on
+// which the centres spread most, then a sweep. The caller's memory; no allocation.
 #include "block_carver.h"
 
 namespace quiver::rt {

@@ -1,6 +1,7 @@
 #include "contact.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstring>
 #include <utility>
@@ -307,20 +308,41 @@ double pairSpeed(const ContactBody& a, const ContactBody& b) {
 }
 
 // The broad phase's intervals: each body's centre and a half width bounding its reach, `reach(b)`,
-// padded so that rounding cannot drop a pair the exact test would keep.
+// padded so that rounding cannot drop a pair the exact test would keep; a body whose reach is not
+// a number (a non-finite velocity, which its step will reset) reaches everything, as the exact
+// tests let it.
 template <class Reach>
 void sortByReach(const ContactBody* bodies, int count, BroadPhase& broad, Reach reach) {
   for (int i = 0; i < count; ++i) {
     const double* x = bodies[i].instance->frame.position;
     std::memcpy(broad.centres + 3 * i, x, 3 * sizeof(double));
     const double w = reach(bodies[i]);
-    broad.halfWidth[i] = w + 1e-9 * (w + std::fabs(x[0]) + std::fabs(x[1]) + std::fabs(x[2]));
+    broad.halfWidth[i] = w <= DBL_MAX ? w + 1e-9 * (w + std::fabs(x[0]) + std::fabs(x[1]) + std::fabs(x[2])) : INFINITY;
   }
   sortIntervals(broad, count);
 }
 
-// How far body b's contacts with others can reach beyond its bounding sphere: its share of any
-// pair's margin (bodyMargin() <= the sum of both shares: a pair's speed is at most both speeds).
+// Calls pair(i, j) once for each pair of bodies whose reaches, `reach(b)` from each centre,
+// overlap along the broad phase's axis (with `broad`), or for every pair (without).
+template <class Reach, class Pair>
+void forEachCandidate(const ContactBody* bodies, int count, BroadPhase* broad, Reach reach, Pair pair) {
+  if (broad) {
+    sortByReach(bodies, count, *broad, reach);
+    forEachOverlap(*broad, pair);
+  } else {
+    for (int i = 0; i < count; ++i)
+      for (int j = i + 1; j < count; ++j) pair(i, j);
+  }
+}
+
+// How far from its centre body b can touch another in the step, bodies grouped or not: its share
+// of a pair's bound in spreadSpeeds() (the larger slop is at most both).
+double groupingReach(const ContactBody& b, double h) {
+  return b.instance->surfaceRadius + b.instance->contactSlop + 2 * h * b.ownSpeed;
+}
+
+// How far from its centre body b's contacts with others can reach: its share of any pair's
+// margin (bodyMargin() <= the sum of both shares: a pair's speed is at most both speeds).
 double contactReach(const ContactBody& b, double h) {
   return b.instance->surfaceRadius + b.instance->contactSlop + 2 * h * (b.ownSpeed + b.groupSpeed);
 }
@@ -369,15 +391,7 @@ void spreadSpeeds(ContactBody* bodies, int count, const qv_collider* colliders, 
     bodies[j].touchSpeed = std::fmax(bodies[j].touchSpeed, speed);
     bodies[groupOf(bodies, i)].group = groupOf(bodies, j);
   };
-  if (broad) {
-    sortByReach(bodies, count, *broad, [&](const ContactBody& b) {
-      return b.instance->surfaceRadius + b.instance->contactSlop + 2 * h * b.ownSpeed;
-    });
-    forEachOverlap(*broad, pair);
-  } else {
-    for (int i = 0; i < count; ++i)
-      for (int j = i + 1; j < count; ++j) pair(i, j);
-  }
+  forEachCandidate(bodies, count, broad, [&](const ContactBody& b) { return groupingReach(b, h); }, pair);
   for (int i = 0; i < count; ++i) bodies[i].groupSpeed = 0;
   for (int i = 0; i < count; ++i) {
     ContactBody& root = bodies[groupOf(bodies, i)];
@@ -600,13 +614,7 @@ int wakeSleepers(ContactBody* bodies, int count, const qv_collider* colliders, i
     const int awake = bodies[i].instance->asleep ? j : i, sleeper = awake == i ? j : i;
     if (withinMargin(bodies, awake, sleeper, bodyMargin(bodies, awake, sleeper, h))) bodies[bodies[sleeper].group].wakes = true;
   };
-  if (broad) {
-    sortByReach(bodies, count, *broad, [&](const ContactBody& b) { return contactReach(b, h); });
-    forEachOverlap(*broad, pair);
-  } else {
-    for (int i = 0; i < count; ++i)
-      for (int j = i + 1; j < count; ++j) pair(i, j);
-  }
+  forEachCandidate(bodies, count, broad, [&](const ContactBody& b) { return contactReach(b, h); }, pair);
   int woken = 0;
   for (int i = 0; i < count; ++i)
     if (bodies[i].instance->asleep && bodies[bodies[i].group].wakes) {
