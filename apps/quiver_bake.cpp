@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
                          "(.obj .gltf .glb .stl .ply .fbx .off ...), tetrahedralized by gmsh into NAME.tets.vtu");
   fixedOptions.addTo(app);
   app.add_option("--tets", s.surface.mesher.targetTets, "A surface input: about this many tets")
-      ->check(CLI::PositiveNumber)->capture_default_str();
+      ->check(app::Positive)->capture_default_str();
   app.add_option("--edge", s.surface.mesher.edgeLength, "A surface input: tet edge length in m (instead of --tets)")
       ->check(app::Positive);
   app.add_option("--min-dihedral", s.surface.mesher.minDihedral,
@@ -83,7 +83,7 @@ int main(int argc, char** argv) {
   app.add_option("--time-step", s.output.model.timeStep, "Suggested time step stored in NAME.qvr, in s")->capture_default_str();
   app.add_option("--fidelity-max-tets", s.fidelity.maxTets,
                  "Run the fidelity report only on meshes of at most this many tets (larger: skipped, saying so)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(app::NonNegative)
       ->capture_default_str();
   app.add_flag("--no-fidelity{false}", s.fidelity.enabled,
                "Skip the fidelity report (the reduced model against full-space StVK on static loads: serial, the "

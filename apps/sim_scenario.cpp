@@ -34,7 +34,7 @@ void SimOptions::addScenarioTo(CLI::App& app) {
   app.add_option("--newton", step.newton,
                  "Newton iterations per implicit step: the most (--solver minimize, default 8; full space, default 20) "
                  "or exactly (--solver newton)")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive);
   app.add_option("--alpha", step.alpha, "Mass-proportional damping, 1/s");
   app.add_option("--beta", step.beta, "Stiffness-proportional damping, s");
   app.add_option("--scenario", scenarioFile,
@@ -92,10 +92,7 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
                            const std::function<void(int)>& afterStep) {
   const std::vector<int> group = selectGroup(mesh, o.group);
   const bool dragMode = o.twist != 0 || o.drag != std::vector<double>{0, 0, 0};
-  const std::vector<double> none{0, 0, 0};
-  const FlightSetup& f = o.flight;
-  if (!o.step.freeFlight && (f.position != none || f.velocity != none || f.angularVelocity != none || !f.colliders.empty() || f.pile > 1))
-    throw std::runtime_error("--position, --velocity, --angular-velocity, --collider and --pile need --free");
+  o.flight.check(o.step.freeFlight);
   if (o.step.freeFlight) target.startFlight(o);
   if (o.gravity) {
     const double g[3] = {0, 0, -kGravity};

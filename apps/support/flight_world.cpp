@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "apps/support/mesh_options.h"
+
 namespace quiver::app {
 
 namespace {
@@ -57,7 +59,7 @@ void FlightSetup::addTo(CLI::App& app) {
                  "touch each other and the colliders (loads act on the first)")
       ->capture_default_str()
       ->check(CLI::Range(1, 4096));
-  app.add_option("--friction", friction, "Free flight: Coulomb friction of the colliders")->capture_default_str()->check(CLI::NonNegativeNumber);
+  app.add_option("--friction", friction, "Free flight: Coulomb friction of the colliders")->capture_default_str()->check(NonNegative);
   app.add_option("--restitution", restitution, "Free flight: restitution of the colliders, 0..1")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
@@ -66,9 +68,17 @@ void FlightSetup::addTo(CLI::App& app) {
                  "Free flight, --pile: bodies that could touch, all slower than this (m/s) for half a second, sleep "
                  "until something wakes them; 0: never")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative);
   app.add_option("--angular-velocity", angularVelocity, "Free flight: initial spin wx,wy,wz, rad/s (world axes)")
       ->delimiter(',')->expected(3);
+}
+
+void FlightSetup::check(bool freeFlight) const {
+  const FlightSetup none;
+  if (!freeFlight && (position != none.position || velocity != none.velocity || angularVelocity != none.angularVelocity ||
+                      !colliders.empty() || pile != 1))
+    throw std::runtime_error("--position, --velocity, --angular-velocity, --collider and --pile need --free");
+  if (pile == 1 && (spread || sleepSpeed != none.sleepSpeed)) throw std::runtime_error("--spread and --sleep-speed need --pile N");
 }
 
 FlightWorld::FlightWorld(const RuntimeModel& model, const RuntimeInstance& first, const FlightSetup& o) : first_(first) {

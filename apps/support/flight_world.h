@@ -29,6 +29,8 @@ struct FlightSetup {
   // --position, --velocity, --angular-velocity, --collider, --pile, --spread, --friction, --restitution,
   // --sleep-speed.
   void addTo(CLI::App& app);
+  // Throws naming the options given that need --free (when not flying) or --pile N.
+  void check(bool freeFlight) const;
 };
 
 class FlightWorld {

@@ -1,6 +1,7 @@
 #include "apps/support/mesh_options.h"
 
 #include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <sstream>
 
@@ -73,12 +74,22 @@ bool parseNumber(const std::string& text, double& value) {
   return used == text.size();
 }
 
-const CLI::Validator Positive(
-    [](std::string& text) -> std::string {
-      double value = 0;
-      return parseNumber(text, value) && value > 0 ? "" : "expected a positive number, not '" + text + "'";
-    },
-    "POSITIVE");
+namespace {
+
+CLI::Validator numberWhere(bool (*holds)(double), const std::string& expected, const std::string& name) {
+  return CLI::Validator(
+      [holds, expected](std::string& text) -> std::string {
+        double value = 0;
+        return parseNumber(text, value) && holds(value) ? "" : "expected " + expected + ", not '" + text + "'";
+      },
+      name);
+}
+
+} // namespace
+
+const CLI::Validator Positive = numberWhere([](double x) { return x > 0 && std::isfinite(x); }, "a positive number", "POSITIVE");
+const CLI::Validator NonNegative =
+    numberWhere([](double x) { return x >= 0 && std::isfinite(x); }, "a number >= 0", "NON-NEGATIVE");
 
 int runTool(const std::string& tool, CLI::App& app, int argc, char** argv, const std::function<int()>& body,
             const ArgumentRewrite& rewrite) {

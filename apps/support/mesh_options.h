@@ -40,9 +40,10 @@ std::vector<int64_t> parseIndexList(const std::string& text, const std::string& 
 // All of `text` as a number (std::stod's syntax); false when it is not one or something follows it.
 bool parseNumber(const std::string& text, double& value);
 
-// A number above zero. CLI::PositiveNumber says "Value abc not in range 0 to 1.79e308" of a word;
-// this says what is expected.
+// A finite number above zero, or at least zero. CLI::PositiveNumber says "Value abc not in range 0
+// to 1.79e308" of a word, and prints that bound in full; these say what is expected.
 extern const CLI::Validator Positive;
+extern const CLI::Validator NonNegative;
 
 // Rewrites the command line (without the program name) before it is parsed; may throw.
 using ArgumentRewrite = std::function<std::vector<std::string>(const std::vector<std::string>&)>;

@@ -469,11 +469,7 @@ int main(int argc, char** argv) {
     if (o.size.size() != 2 || o.size[0] < 64 || o.size[1] < 64 || o.size[0] > 8192 || o.size[1] > 8192)
       throw std::runtime_error("--size must be two numbers between 64 and 8192");
     if (!o.screenshot.empty() && o.frames == 0) throw std::runtime_error("--screenshot needs --frames N");
-    const FlightSetup none;
-    if (!o.settings.step.freeFlight && (o.flight.position != none.position || o.flight.velocity != none.velocity ||
-                                        o.flight.angularVelocity != none.angularVelocity || !o.flight.colliders.empty() ||
-                                        o.flight.pile != 1))
-      throw std::runtime_error("--position, --velocity, --angular-velocity, --collider and --pile need --free");
+    o.flight.check(o.settings.step.freeFlight);
     if (o.settings.step.freeFlight && !o.showMode.empty()) throw std::runtime_error("--show-mode shows a model in place: not with --free");
     if (o.settings.step.freeFlight) o.settings.gravity = true;
     const RuntimeModel model(o.model);

@@ -191,6 +191,12 @@ class FreeFlight(unittest.TestCase):
         self.assertIn("pinned.qvr was baked with fixed vertices", p.stderr)
         p = run(QUIVER, "sim", self.free + ".qvr", "--free", "--angular-velocity", "nan,0,0", "--steps", 2, codes=(1,))
         self.assertIn("must be finite", p.stderr)
+        for option in (["--spread"], ["--sleep-speed", "0"]):
+            p = run(QUIVER, "sim", self.free + ".qvr", "--free", *option, "--steps", 2, codes=(1,))
+            self.assertIn("need --pile N", p.stderr)
+        for option in ("--sleep-speed", "--friction"):
+            p = run(QUIVER, "sim", self.free + ".qvr", "--free", "--pile", 2, option, "-1", "--steps", 2, codes=(105,))
+            self.assertIn(f"{option}: expected a number >= 0, not '-1'", p.stderr)
 
 
 if __name__ == "__main__":
