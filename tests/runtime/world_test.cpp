@@ -285,6 +285,16 @@ int asleep(const World& world) {
   return n;
 }
 
+// Whether `s` is asleep after some step of the next `steps`.
+bool sleepsWithin(World& world, qv_instance* s, int steps) {
+  bool slept = false;
+  for (int i = 0; i < steps; ++i) {
+    EXPECT_EQ(qv_world_step(world.w), 0);
+    slept |= qv_instance_asleep(s) != 0;
+  }
+  return slept;
+}
+
 // The same pile twice, sleeping and awake. Asleep, it must rest where the awake one rests (a
 // group put to sleep while still settling would stay where it was caught), not move at all, and
 // have no contacts.
@@ -321,12 +331,8 @@ TEST(World, ASettledPileFallsAsleepWhereItRestsAndStaysThere) {
   EXPECT_LT(apart, 0.002);
 }
 
-// Two bars crosswise on the ground, asleep; a third dropped from 0.3 m above must wake them and
-// land on them, not pass through the sleepers (their contacts are not sought while they sleep).
-TEST(World, ABarDroppedOnASleepingStackWakesItAndLandsOnIt) {
-  FreeBar bar(16, {12, 2, 2});
-  const double h = 1.0 / 60;
-  World world(0.5, 0, 4096, kSleepSpeed);
+// Two bars crosswise on the ground (instances 0 and 1), stepped until both sleep.
+void laySleepingStack(World& world, const FreeBar& bar, double h) {
   world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0)};
   world.setColliders();
   qv_rigid_state turned = at(0.3, 0.05, 0.155);
@@ -335,6 +341,16 @@ TEST(World, ABarDroppedOnASleepingStackWakesItAndLandsOnIt) {
   world.add(bar, h, turned, true);
   for (int i = 0; i < 120 && asleep(world) < 2; ++i) ASSERT_EQ(qv_world_step(world.w), 0);
   ASSERT_EQ(asleep(world), 2);
+}
+
+// A third bar dropped from 0.3 m above a sleeping stack must wake it and land on it, not pass
+// through the sleepers (their contacts are not sought while they sleep).
+TEST(World, ABarDroppedOnASleepingStackWakesItAndLandsOnIt) {
+  FreeBar bar(16, {12, 2, 2});
+  const double h = 1.0 / 60;
+  World world(0.5, 0, 4096, kSleepSpeed);
+  laySleepingStack(world, bar, h);
+  ASSERT_FALSE(HasFatalFailure());
   world.add(bar, h, at(0.3, 0.05, 0.55), true);
   bool woke = false;
   for (int i = 0; i < 180; ++i) {
@@ -369,11 +385,7 @@ TEST(World, ASleepingBarWakesWhenItsPlatformMovesAndRidesIt) {
   }
   const double carried = world.colliders[0].data[0] - 0.3, moved = centre(s).x() - x0;
   world.colliders[0].velocity[0] = 0;
-  bool sleepsAgain = false;
-  for (int i = 0; i < 120; ++i) {
-    ASSERT_EQ(qv_world_step(world.w), 0);
-    sleepsAgain |= qv_instance_asleep(s) != 0;
-  }
+  const bool sleepsAgain = sleepsWithin(world, s, 120);
   std::printf("platform moved %.4f m; the bar on it, asleep before, %.4f m; asleep again after it stopped: %s\n", carried,
               moved, sleepsAgain ? "yes" : "no");
   EXPECT_NEAR(moved, carried, 0.05 * carried);
@@ -424,14 +436,9 @@ TEST(World, TheLowestPulledFromASleepingStackLetsTheOneAboveFall) {
   FreeBar bar(16, {12, 2, 2});
   const double h = 1.0 / 60;
   World world(0.5, 0, 4096, kSleepSpeed);
-  world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0)};
-  world.setColliders();
-  qv_rigid_state turned = at(0.3, 0.05, 0.155);
-  turned.orientation[0] = turned.orientation[3] = std::sqrt(0.5);
-  qv_instance* lower = world.add(bar, h, at(0.3, 0.05, 0.052), true);
-  qv_instance* upper = world.add(bar, h, turned, true);
-  for (int i = 0; i < 120 && asleep(world) < 2; ++i) ASSERT_EQ(qv_world_step(world.w), 0);
-  ASSERT_EQ(asleep(world), 2);
+  laySleepingStack(world, bar, h);
+  ASSERT_FALSE(HasFatalFailure());
+  qv_instance *lower = world.bodies[0]->s, *upper = world.bodies[1]->s;
   const qv_rigid_state aside = at(3, 0.05, 0.052);
   EXPECT_EQ(qv_instance_set_rigid_state(lower, &aside), QV_OK);
   for (int i = 0; i < 60; ++i) ASSERT_EQ(qv_world_step(world.w), 0);
@@ -481,11 +488,7 @@ TEST(World, AStillBarBesideAMovingColliderStaysAwake) {
     asleepSteps += qv_instance_asleep(s);
   }
   world.colliders[1].angular_velocity[2] = 0;
-  bool sleepsOnceStopped = false;
-  for (int i = 0; i < 60; ++i) {
-    ASSERT_EQ(qv_world_step(world.w), 0);
-    sleepsOnceStopped |= qv_instance_asleep(s) != 0;
-  }
+  const bool sleepsOnceStopped = sleepsWithin(world, s, 60);
   std::printf("beside a spinning ball: asleep in %d of 120 steps; asleep once it stopped: %s\n", asleepSteps,
               sleepsOnceStopped ? "yes" : "no");
   EXPECT_EQ(asleepSteps, 0);
