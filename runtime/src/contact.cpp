@@ -14,6 +14,7 @@ namespace {
 
 constexpr double kSoftness = 0.1;
 constexpr int kSweeps = 24;
+constexpr double kMaxPushOut = 1.0;  // m/s: the fastest a penetration is pushed out
 
 double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 double norm3(const double a[3]) { return std::sqrt(dot3(a, a)); }
@@ -625,6 +626,54 @@ int wakeSleepers(ContactBody* bodies, int count, const qv_collider* colliders, i
   return woken;
 }
 
+namespace {
+
+// Body b's pair with a collider or another body, or null.
+ContactPair* pairOf(ContactList& list, const ContactBody& b, int other, int collider) {
+  for (int p = b.firstPair; p < b.pairEnd; ++p)
+    if (list.pairs[p].other == other && list.pairs[p].collider == collider) return &list.pairs[p];
+  return nullptr;
+}
+
+// Deeper than a resting contact sinks (3 slops and 2 g h^2, below) and a slop more.
+bool deep(const Contact& ct, const qv_instance& s, double h) {
+  return ct.depth < -(4 * s.contactSlop + 2 * norm3(s.frame.gravity) * h * h);
+}
+
+// A vertex deep inside another body or a collider (spawned there, or pushed in) takes the nearest
+// face, and deep inside that is any face: one pair's contacts then push every way at once, which
+// no velocities satisfy, so their impulses grew sweep after sweep, loaded q with them and spun the
+// frames (a bar spawned through a cube's middle flew off at 84 m/s, spinning at 2900 rad/s). Each
+// pair (both directions of a pair of bodies) keeps only the deep contacts that push along its mean
+// push, the deep contacts' normals weighted by their depths.
+void keepConsistentPushes(const ContactBody* bodies, ContactList& list, double h) {
+  bool any = false;
+  for (int p = 0; p < list.pairCount; ++p) std::fill(list.pairs[p].push, list.pairs[p].push + 3, 0.0);
+  for (int k = 0; k < list.count; ++k) {
+    const Contact& ct = list.contacts[k];
+    if (!deep(ct, *bodies[ct.body].instance, h)) continue;
+    ContactPair* pair = pairOf(list, bodies[ct.body], ct.other, ct.collider);
+    for (int a = 0; a < 3 && pair; ++a) pair->push[a] -= ct.depth * ct.normal[a];
+    any = true;
+  }
+  if (!any) return;
+  int kept = 0;
+  for (int k = 0; k < list.count; ++k) {
+    const Contact& ct = list.contacts[k];
+    if (deep(ct, *bodies[ct.body].instance, h)) {
+      const ContactPair* pair = pairOf(list, bodies[ct.body], ct.other, ct.collider);
+      const ContactPair* back = ct.other >= 0 ? pairOf(list, bodies[ct.other], ct.body, -1) : nullptr;
+      double along = 0;  // the pair's mean push on this body, along this contact's normal
+      for (int a = 0; a < 3; ++a) along += ((pair ? pair->push[a] : 0) - (back ? back->push[a] : 0)) * ct.normal[a];
+      if (!(along > 0)) continue;
+    }
+    list.contacts[kept++] = ct;
+  }
+  list.count = kept;
+}
+
+} // namespace
+
 void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* colliders, int colliderCount,
                    const ContactMaterial& material, ContactList& list, double h, BroadPhase* broad) {
   std::swap(list.contacts, list.previous);
@@ -668,6 +717,7 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
   }
   if (!list.count) return;
   std::sort(list.contacts, list.contacts + list.count, keyBefore);
+  keepConsistentPushes(bodies, list, h);
 
   // The relative velocity at a contact: body's frame less the other's (or the collider's surface).
   const auto relativeVelocity = [&](const Contact& ct, double out[3]) {
@@ -697,7 +747,7 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     relativeVelocity(ct, vel);
     const double vn = dot3(vel, ct.normal);
     // Approach until the surfaces meet, no further; push out what penetrates beyond the slop.
-    ct.target = ct.depth > slop ? -ct.depth / h : 0.2 * (-ct.depth - slop) / h;
+    ct.target = ct.depth > slop ? -ct.depth / h : std::fmin(0.2 * (-ct.depth - slop) / h, kMaxPushOut);
     ct.bounce = vn < -bounceSpeed ? -ct.restitution * vn : 0.0;
     ct.normalMass = effectiveMass(ct, ct.normal);
     ct.restingImpulse = 4 * ct.normalMass * (norm3(s.frame.gravity) * h + slop / h);

@@ -11,9 +11,12 @@
 //   up to a capacity: when more are found, each pair (a body against a collider or another body)
 //   keeps its vertices down to a level (contact_points.h), a subset spread over its patch; the
 //   pairs with the most give up levels first;
+// - a vertex deeper than resting contacts sink (spawned or pushed deep inside) takes whichever face
+//   is nearest, so each pair keeps only its deep contacts that push along the pair's mean push
+//   (opposed pushes grew without bound and flung the bodies off);
 // - sequential impulses (24 sweeps) on the frames' velocities and angular momenta: a normal impulse
 //   >= 0 that stops the approach where the surfaces meet (so nothing tunnels while it is seen) and
-//   pushes out what penetrates beyond a slop, slightly soft so that a resting face shares its weight
+//   pushes out what penetrates beyond a slop (at 1 m/s at most), slightly soft so that a resting face shares its weight
 //   by depth; from the middle sweep on, contacts that push aim at the bounce (restitution x the
 //   approach speed, when faster than the step's gravity gives); a tangent impulse within the Coulomb
 //   disc mu * normal. Velocity-level constraints: stiff contact at any time step, no penalty

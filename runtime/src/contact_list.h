@@ -37,6 +37,7 @@ struct ContactPair {
   int body = 0, other = -1, collider = -1;
   int count[kContactLevels] = {};  // candidates by level
   int minLevel = 0;  // kept: candidates of this level and above
+  double push[3] = {};  // its deep contacts' normals, each times its depth (keepConsistentPushes(), contact.cpp)
 };
 
 // Where a solve puts its contacts: `contacts` this step's, `previous` the last step's (sorted by

@@ -23,8 +23,9 @@ struct FreeBar {
   qv_model_info info{};
   Eigen::SparseMatrix<double> mass;  // n x n, the consistent mass's x-x block
 
-  explicit FreeBar(int rank = 10, std::array<int, 3> cells = {6, 1, 1}) {
+  explicit FreeBar(int rank = 10, std::array<int, 3> cells = {6, 1, 1}, Eigen::Vector3d size = {0.6, 0.1, 0.1}) {
     test::SmallModelSpec spec;
+    spec.size = size;
     spec.cells = cells;
     spec.free = true;
     spec.rank = rank;
