@@ -14,7 +14,7 @@ namespace {
 
 constexpr double kSoftness = 0.1;
 constexpr int kSweeps = 24;
-constexpr double kMaxPushOut = 1.0;  // m/s: the fastest a penetration is pushed out
+constexpr double kMaxPushOut = 1.0;  // m/s: the fastest a deep penetration is pushed out
 
 double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 double norm3(const double a[3]) { return std::sqrt(dot3(a, a)); }
@@ -450,13 +450,16 @@ double keptReach(const ContactList& list, double margin, double slop) {
 // (3 slops and 2 g h^2, the soft contacts' most at rest, solveContacts()) beyond the margin: that
 // is some other part of the surface. Returns whether it took that part's depth and normal (the
 // caller refuses it beyond its reach, as the first answer).
+// How deep a touching contact sinks at most: the soft contacts' most at rest (solveContacts()).
+double restingSink(const qv_instance& s, double h) { return 3 * s.contactSlop + 2 * norm3(s.frame.gravity) * h * h; }
+
 template <class Query>
 bool pressFacing(const qv_instance& s, int v, double margin, double h, double& depth, double normal[3], double own[3],
                  Query query) {
   if (depth > s.contactSlop || !s.model->surfaceMesh) return false;
   s.frame.toWorldDirection(s.model->surfaceMesh->vertexNormals + 3 * v, own);
   double facingDepth, facingNormal[3];
-  const double deepest = margin + 3 * s.contactSlop + 2 * norm3(s.frame.gravity) * h * h;
+  const double deepest = margin + restingSink(s, h);
   if (dot3(own, normal) <= 0 || !query(facingDepth, facingNormal) || std::fabs(facingDepth) > deepest) return false;
   depth = facingDepth;
   std::memcpy(normal, facingNormal, sizeof facingNormal);
@@ -635,37 +638,48 @@ ContactPair* pairOf(ContactList& list, const ContactBody& b, int other, int coll
   return nullptr;
 }
 
-// Deeper than a resting contact sinks (3 slops and 2 g h^2, below) and a slop more.
-bool deep(const Contact& ct, const qv_instance& s, double h) {
-  return ct.depth < -(4 * s.contactSlop + 2 * norm3(s.frame.gravity) * h * h);
-}
+// Deeper than a resting contact sinks, and a slop more.
+bool deep(const Contact& ct, const qv_instance& s, double h) { return ct.depth < -(restingSink(s, h) + s.contactSlop); }
 
 // A vertex deep inside another body or a collider (spawned there, or pushed in) takes the nearest
 // face, and deep inside that is any face: one pair's contacts then push every way at once, which
 // no velocities satisfy, so their impulses grew sweep after sweep, loaded q with them and spun the
 // frames (a bar spawned through a cube's middle flew off at 84 m/s, spinning at 2900 rad/s). Each
 // pair (both directions of a pair of bodies) keeps only the deep contacts that push along its mean
-// push, the deep contacts' normals weighted by their depths.
+// push, the deep contacts' normals weighted by their depths; where those cancel (a body spawned at
+// another's centre), along its shallowest deep contact, the nearest way out. A contact whose pair
+// the full table could not hold stays.
 void keepConsistentPushes(const ContactBody* bodies, ContactList& list, double h) {
   bool any = false;
-  for (int p = 0; p < list.pairCount; ++p) std::fill(list.pairs[p].push, list.pairs[p].push + 3, 0.0);
+  for (int p = 0; p < list.pairCount; ++p) {
+    ContactPair& pair = list.pairs[p];
+    std::fill(pair.push, pair.push + 3, 0.0);
+    pair.weight = 0, pair.exitDepth = -INFINITY;
+  }
   for (int k = 0; k < list.count; ++k) {
     const Contact& ct = list.contacts[k];
-    if (!deep(ct, *bodies[ct.body].instance, h)) continue;
-    ContactPair* pair = pairOf(list, bodies[ct.body], ct.other, ct.collider);
-    for (int a = 0; a < 3 && pair; ++a) pair->push[a] -= ct.depth * ct.normal[a];
+    ContactPair* pair = deep(ct, *bodies[ct.body].instance, h) ? pairOf(list, bodies[ct.body], ct.other, ct.collider) : nullptr;
+    if (!pair) continue;
+    for (int a = 0; a < 3; ++a) pair->push[a] -= ct.depth * ct.normal[a];
+    pair->weight -= ct.depth;
+    if (ct.depth > pair->exitDepth) pair->exitDepth = ct.depth, std::memcpy(pair->exit, ct.normal, sizeof pair->exit);
     any = true;
   }
   if (!any) return;
   int kept = 0;
   for (int k = 0; k < list.count; ++k) {
     const Contact& ct = list.contacts[k];
-    if (deep(ct, *bodies[ct.body].instance, h)) {
-      const ContactPair* pair = pairOf(list, bodies[ct.body], ct.other, ct.collider);
+    const ContactPair* pair = deep(ct, *bodies[ct.body].instance, h) ? pairOf(list, bodies[ct.body], ct.other, ct.collider) : nullptr;
+    if (pair) {
       const ContactPair* back = ct.other >= 0 ? pairOf(list, bodies[ct.other], ct.body, -1) : nullptr;
-      double along = 0;  // the pair's mean push on this body, along this contact's normal
-      for (int a = 0; a < 3; ++a) along += ((pair ? pair->push[a] : 0) - (back ? back->push[a] : 0)) * ct.normal[a];
-      if (!(along > 0)) continue;
+      // The pair's push on this body: its own deep contacts' less the other's on it.
+      double push[3];
+      for (int a = 0; a < 3; ++a) push[a] = pair->push[a] - (back ? back->push[a] : 0);
+      if (norm3(push) <= 1e-6 * (pair->weight + (back ? back->weight : 0))) {
+        const bool backExits = back && back->exitDepth > pair->exitDepth;
+        for (int a = 0; a < 3; ++a) push[a] = backExits ? -back->exit[a] : pair->exit[a];
+      }
+      if (!(dot3(push, ct.normal) > 0)) continue;
     }
     list.contacts[kept++] = ct;
   }
@@ -747,7 +761,8 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     relativeVelocity(ct, vel);
     const double vn = dot3(vel, ct.normal);
     // Approach until the surfaces meet, no further; push out what penetrates beyond the slop.
-    ct.target = ct.depth > slop ? -ct.depth / h : std::fmin(0.2 * (-ct.depth - slop) / h, kMaxPushOut);
+    const double pushOut = 0.2 * (-ct.depth - slop) / h;
+    ct.target = ct.depth > slop ? -ct.depth / h : deep(ct, s, h) ? std::fmin(pushOut, kMaxPushOut) : pushOut;
     ct.bounce = vn < -bounceSpeed ? -ct.restitution * vn : 0.0;
     ct.normalMass = effectiveMass(ct, ct.normal);
     ct.restingImpulse = 4 * ct.normalMass * (norm3(s.frame.gravity) * h + slop / h);

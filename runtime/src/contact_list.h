@@ -37,7 +37,9 @@ struct ContactPair {
   int body = 0, other = -1, collider = -1;
   int count[kContactLevels] = {};  // candidates by level
   int minLevel = 0;  // kept: candidates of this level and above
-  double push[3] = {};  // its deep contacts' normals, each times its depth (keepConsistentPushes(), contact.cpp)
+  // Its deep contacts (keepConsistentPushes(), contact.cpp): their normals each times its depth,
+  // the sum of their depths, and the normal of the shallowest (exitDepth its depth).
+  double push[3] = {}, weight = 0, exit[3] = {}, exitDepth = 0;
 };
 
 // Where a solve puts its contacts: `contacts` this step's, `previous` the last step's (sorted by
