@@ -418,18 +418,6 @@ bool withinMargin(const ContactBody* bodies, int i, int j, double margin) {
   return norm3(gap) <= a.surfaceRadius + b.surfaceRadius + margin;
 }
 
-// The solve starts from the frames' momenta as their velocity updates left them.
-void takeMomenta(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h,
-                 BroadPhase* broad) {
-  for (int i = 0; i < count; ++i) {
-    ContactBody& b = bodies[i];
-    const RigidFrame& f = b.instance->frame;
-    std::memcpy(b.velocity, f.velocity, sizeof b.velocity);
-    std::memcpy(b.angularMomentum, f.angularMomentum, sizeof b.angularMomentum);
-    f.worldOmega(b.omega);
-  }
-  spreadSpeeds(bodies, count, colliders, colliderCount, h, broad);
-}
 
 // How far from a surface a candidate can be and still be kept: a full list takes only those its
 // poorest would give way to (admit()), so the closest-point queries need not look farther (in a
@@ -605,9 +593,19 @@ bool colliderDistance(const qv_collider& c, const double p[3], double reach, dou
   return true;
 }
 
-int wakeSleepers(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h,
+void takeMomenta(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h,
                  BroadPhase* broad) {
-  takeMomenta(bodies, count, colliders, colliderCount, h, broad);
+  for (int i = 0; i < count; ++i) {
+    ContactBody& b = bodies[i];
+    const RigidFrame& f = b.instance->frame;
+    std::memcpy(b.velocity, f.velocity, sizeof b.velocity);
+    std::memcpy(b.angularMomentum, f.angularMomentum, sizeof b.angularMomentum);
+    f.worldOmega(b.omega);
+  }
+  spreadSpeeds(bodies, count, colliders, colliderCount, h, broad);
+}
+
+int wakeSleepers(ContactBody* bodies, int count, double h, BroadPhase* broad) {
   for (int i = 0; i < count; ++i) bodies[i].wakes = false;
   for (int i = 0; i < count; ++i)
     if (!bodies[i].instance->asleep || bodies[i].nearMovingCollider) bodies[bodies[i].group].wakes = true;
@@ -694,7 +692,6 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
   list.previousCount = list.count;
   list.count = 0;
   list.full = false;
-  takeMomenta(bodies, bodyCount, colliders, colliderCount, h, broad);
   // Each body's candidates in ascending order (as a scan of all would meet them: a full list's
   // choice depends on the order it meets its candidates).
   if (broad) {

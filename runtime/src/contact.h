@@ -62,19 +62,25 @@ bool colliderDistance(const qv_collider& collider, const double p[3], double rea
                       const double* facing = nullptr);
 bool validCollider(const qv_collider& collider);
 
+// The solve starts from the frames' momenta as their velocity updates left them: takes them into
+// `bodies`, and groups the bodies and spreads their speeds (contact.cpp, spreadSpeeds()). Call
+// after the frames' velocity updates, before wakeSleepers() and solveContacts(), and again after
+// wakeSleepers() woke some.
+void takeMomenta(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h,
+                 BroadPhase* broad = nullptr);
+
 // Finds the step's contacts of `bodies` with `colliders` and with each other, solves their
 // impulses into the frames' velocities and angular momenta, and adds their forces on q. Call after
-// the frames' velocity updates, before they move; all bodies share the time step h. Sleeping
+// takeMomenta(), before the frames move; all bodies share the time step h. Sleeping
 // bodies (qv_instance::asleep, at rest) take no part: none may be within an awake body's reach
 // (wakeSleepers()). With `broad` (a world's), the pairs of bodies tested are its overlaps
 // (broad_phase.h); without, every pair.
 void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* colliders, int colliderCount,
                    const ContactMaterial& between, ContactList& list, double h, BroadPhase* broad = nullptr);
 
-// Wakes every sleeping body whose group (as the solve will group them) holds an awake body or
-// meets a moving collider, and every one within an awake body's margin; returns how many. Woken
-// bodies start their step and move, so call again until it wakes none.
-int wakeSleepers(ContactBody* bodies, int count, const qv_collider* colliders, int colliderCount, double h,
-                 BroadPhase* broad = nullptr);
+// Wakes every sleeping body whose group (takeMomenta()'s, as the solve will group them) holds an
+// awake body or meets a moving collider, and every one within an awake body's margin; returns how
+// many. Woken bodies start their step and move: take the momenta and call again until it wakes none.
+int wakeSleepers(ContactBody* bodies, int count, double h, BroadPhase* broad = nullptr);
 
 } // namespace quiver::rt

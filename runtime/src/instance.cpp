@@ -211,6 +211,7 @@ void qv_instance::beginStep() {
 void qv_instance::solveOwnContacts() {
   quiver::rt::ContactBody body;
   body.instance = this;
+  quiver::rt::takeMomenta(&body, 1, colliders, colliderCount, config.time_step);
   quiver::rt::solveContacts(&body, 1, colliders, colliderCount, quiver::rt::ContactMaterial{}, contacts, config.time_step);
 }
 

@@ -108,10 +108,13 @@ int qv_world::step() {
   int awake = 0;
   for (int i = 0; i < count; ++i)
     if (!instances[i]->asleep) begin(i), ++awake;
+  quiver::rt::takeMomenta(bodies, count, colliders, colliderCount, h, &broad);
   // Woken bodies start their step and may reach other sleepers in it.
-  while (awake < count && quiver::rt::wakeSleepers(bodies, count, colliders, colliderCount, h, &broad))
+  while (awake < count && quiver::rt::wakeSleepers(bodies, count, h, &broad)) {
     for (int i = 0; i < count; ++i)
       if (!instances[i]->asleep && !slots[i].begun) begin(i), ++awake;
+    quiver::rt::takeMomenta(bodies, count, colliders, colliderCount, h, &broad);
+  }
   const quiver::rt::ContactMaterial between{config.friction, config.restitution};
   if (awake) {
     quiver::rt::solveContacts(bodies, count, colliders, colliderCount, between, contacts, h, &broad);

@@ -158,7 +158,9 @@ TEST(BroadPhase, AContactSolveFindsWhatTestingEveryPairFinds) {
         lists[set].pairs = pairs[set].data(), lists[set].capacity = capacity;
       }
       Scene broad(n);
+      takeMomenta(bodies[0].data(), n, nullptr, 0, h, &broad.broad);
       solveContacts(bodies[0].data(), n, nullptr, 0, ContactMaterial{}, lists[0], h, &broad.broad);
+      takeMomenta(bodies[1].data(), n, nullptr, 0, h, nullptr);
       solveContacts(bodies[1].data(), n, nullptr, 0, ContactMaterial{}, lists[1], h, nullptr);
       int candidates = 0;
       forEachOverlap(broad.broad, [&](int, int) { ++candidates; });
