@@ -64,4 +64,40 @@ inline bool choleskySolve(double* A, double* b, int n) {
   return true;
 }
 
+// Diagonalises symmetric A = V diag(lambda) V^T (row-major, n x n) by cyclic Jacobi rotations:
+// A is overwritten (its diagonal ends as lambda), V (n x n, row-major) receives the eigenvectors
+// as columns. Accurate to rounding for the small matrices a model loads once (K(0), r x r).
+inline void symmetricEigen(double* A, double* V, int n) {
+  for (int i = 0; i < n * n; ++i) V[i] = i % (n + 1) == 0 ? 1.0 : 0.0;
+  for (int sweep = 0; sweep < 64; ++sweep) {
+    double off = 0, diagonal = 0;
+    for (int i = 0; i < n; ++i) {
+      diagonal += A[i * n + i] * A[i * n + i];
+      for (int j = i + 1; j < n; ++j) off += A[i * n + j] * A[i * n + j];
+    }
+    if (!(off > 1e-32 * diagonal)) return;  // converged (or not finite: nothing better to do)
+    for (int p = 0; p < n; ++p)
+      for (int q = p + 1; q < n; ++q) {
+        const double apq = A[p * n + q];
+        if (apq == 0) continue;
+        // The rotation (c, s) that zeroes A[p][q]: t = tan of its angle, the smaller root.
+        const double theta = (A[q * n + q] - A[p * n + p]) / (2 * apq);
+        const double t = (theta >= 0 ? 1.0 : -1.0) / (std::fabs(theta) + std::sqrt(theta * theta + 1));
+        const double c = 1 / std::sqrt(t * t + 1), s = t * c;
+        for (int k = 0; k < n; ++k) {  // columns p and q: A <- A J
+          const double akp = A[k * n + p], akq = A[k * n + q];
+          A[k * n + p] = c * akp - s * akq, A[k * n + q] = s * akp + c * akq;
+        }
+        for (int k = 0; k < n; ++k) {  // rows p and q: A <- J^T A
+          const double apk = A[p * n + k], aqk = A[q * n + k];
+          A[p * n + k] = c * apk - s * aqk, A[q * n + k] = s * apk + c * aqk;
+        }
+        for (int k = 0; k < n; ++k) {  // V <- V J
+          const double vkp = V[k * n + p], vkq = V[k * n + q];
+          V[k * n + p] = c * vkp - s * vkq, V[k * n + q] = s * vkp + c * vkq;
+        }
+      }
+  }
+}
+
 } // namespace quiver::rt

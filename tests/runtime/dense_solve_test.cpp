@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -76,5 +77,30 @@ TEST(DenseSolve, CholeskyLanesFactoriseEachLaneAsAloneAndKeepABadLaneToItself) {
       ASSERT_TRUE(choleskyFactor(alone.data(), size));
       EXPECT_LT((alone.triangularView<Eigen::Upper>().toDenseMatrix() - U).norm(), 1e-13 * U.norm()) << size << " lane " << l;
     }
+  }
+}
+
+TEST(DenseSolve, SymmetricEigenAgainstEigen) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0, 1);
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  for (int size : {1, 2, 7, 40}) {
+    Eigen::MatrixXd B(size, size);
+    for (auto& x : B.reshaped()) x = n(rng);
+    Eigen::MatrixXd symmetric = B + B.transpose();
+    if (size > 2) {  // a repeated eigenvalue, as a square bar's two bending modes have
+      const Eigen::MatrixXd Q = Eigen::HouseholderQR<Eigen::MatrixXd>(B).householderQ();
+      Eigen::VectorXd lambda = Eigen::VectorXd::LinSpaced(size, 1, size);
+      lambda(1) = lambda(0);
+      symmetric = Q * lambda.asDiagonal() * Q.transpose();
+    }
+    RowMajor A = symmetric, V(size, size);
+    symmetricEigen(A.data(), V.data(), size);
+    const Eigen::VectorXd lambda = A.diagonal();
+    EXPECT_LT((V * lambda.asDiagonal() * V.transpose() - symmetric).norm(), 1e-12 * symmetric.norm());
+    EXPECT_LT((V.transpose() * V - Eigen::MatrixXd::Identity(size, size)).norm(), 1e-12 * size);
+    Eigen::VectorXd sorted = lambda;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_LT((sorted - Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(symmetric).eigenvalues()).norm(), 1e-12 * symmetric.norm());
   }
 }
