@@ -146,6 +146,10 @@ qv_result loadModel(const void* data, size_t size, const qv_model_config& config
     }
     model->surfaceMesh = surface;
   }
+  if (model->contactCount > 0 && !buildContactModes(*model, allocator, model->contactModes)) {
+    destroyModel(model);
+    return QV_ERROR_OUT_OF_MEMORY;
+  }
   *out = model;
   return QV_OK;
 }
@@ -153,6 +157,7 @@ qv_result loadModel(const void* data, size_t size, const qv_model_config& config
 void destroyModel(qv_model* model) {
   const qv_allocator allocator = model->allocator;
   if (model->surfaceMesh) destroyTriangleMesh(const_cast<qv_triangle_mesh*>(model->surfaceMesh));
+  destroyContactModes(model->contactModes, allocator);
   model->~qv_model();
   allocator.release(model, allocator.user);
 }

@@ -1,9 +1,10 @@
 #pragma once
 // qv_model: a baked model in one block from the caller's allocator (and, for a free model, its
-// surface as a triangle mesh in a second), immutable once loaded and shared read-only by every
-// instance of it.
+// surface as a triangle mesh in a second and its contact modes in a third, contact_modes.h),
+// immutable once loaded and shared read-only by every instance of it.
 #include <cstddef>
 
+#include "contact_modes.h"
 #include "quiver/quiver.h"
 #include "reduced_polynomial.h"
 #include "render_mesh.h"
@@ -32,6 +33,7 @@ struct qv_model {
   const int* contactVertices;
   const unsigned char* contactLevels;
   int contactCount;
+  quiver::rt::ContactModes contactModes;  // how the deformation gives way at them (free models)
 
   double basisEntry(size_t row, size_t j) const {
     const size_t r = static_cast<size_t>(info.r);
