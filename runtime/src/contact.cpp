@@ -140,6 +140,40 @@ void applyImpulse(ContactBody& b, const double a[3], const double J[3], double s
   }
 }
 
+// Mode i's share of body vector d at a contact point whose rows of U V are `rows` (contact_modes.h):
+// ((U V)_v^T d)_i.
+double modeShare(const double* rows, int r, int i, const double d[3]) {
+  return rows[i] * d[0] + rows[r + i] * d[1] + rows[2 * r + i] * d[2];
+}
+
+// A contact side's deformation in the contact modes, at its vertex, whose rows of U V are `rows`:
+// its velocity over the step so far (world), as predicted and as the solve's impulses change it ...
+void modeVelocityAt(const qv_instance& s, const double* rows, double out[3]) {
+  const int r = s.r;
+  double local[3] = {};
+  for (int a = 0; a < 3; ++a)
+    for (int i = 0; i < r; ++i) local[a] += rows[a * r + i] * s.modeVelocity[i];
+  s.frame.toWorldDirection(local, out);
+}
+
+// ... how far it gives way along d (world) per unit impulse along d, g^T diag(c) g, g = (U V)_v^T R^T d ...
+double modeGiving(const qv_instance& s, const double* rows, const double d[3]) {
+  double n[3], sum = 0;
+  s.frame.toBody(d, n);
+  for (int i = 0; i < s.r; ++i) {
+    const double g = modeShare(rows, s.r, i, n);
+    sum += s.modeCompliance[i] * g * g;
+  }
+  return sum;
+}
+
+// ... and an impulse J (world) on it.
+void pushModes(qv_instance& s, const double* rows, const double J[3], double sign) {
+  double n[3];
+  s.frame.toBody(J, n);
+  for (int i = 0; i < s.r; ++i) s.modeVelocity[i] += sign * s.modeCompliance[i] * modeShare(rows, s.r, i, n);
+}
+
 // Vertex v of a body's rest shape, carried by its frame (or deformed by q when `deformed`).
 void worldVertex(const qv_instance& s, int v, bool deformed, double out[3]) {
   const qv_model& m = *s.model;
@@ -458,10 +492,11 @@ bool pressFacing(const qv_instance& s, int v, double margin, double h, double& d
 void findColliderContacts(ContactBody* bodies, int i, const qv_collider* colliders, int count, double h,
                           ContactList& list) {
   const qv_instance& s = *bodies[i].instance;
+  const bool deforms = s.modeCompliance != nullptr;  // its contacts hold the deformed surface
   for (int n = 0; n < s.surfaceCount && count; ++n) {
     const int v = s.surfaceVertices[n];
     double p[3];
-    worldVertex(s, v, false, p);
+    worldVertex(s, v, deforms, p);
     for (int k = 0; k < count; ++k) {
       const qv_collider& col = colliders[k];
       double u[3], depth, normal[3];
@@ -477,9 +512,12 @@ void findColliderContacts(ContactBody* bodies, int i, const qv_collider* collide
       Contact* ct = admit(list, bodies[i], i, -1, k, n, depth);
       if (!ct) continue;
       ct->friction = col.friction, ct->restitution = col.restitution;
-      double deformed[3], ignored[3];
-      worldVertex(s, v, true, deformed);
-      colliderDistance(col, deformed, INFINITY, ct->deformedDepth, ignored, facing ? own : nullptr);
+      ct->deformedDepth = depth;
+      if (!deforms) {
+        double deformed[3], ignored[3];
+        worldVertex(s, v, true, deformed);
+        colliderDistance(col, deformed, INFINITY, ct->deformedDepth, ignored, facing ? own : nullptr);
+      }
       for (int a = 0; a < 3; ++a) {
         ct->point[a] = p[a], ct->normal[a] = normal[a], ct->surfaceVelocity[a] = u[a];
         ct->arm[a] = p[a] - s.frame.position[a];
@@ -495,11 +533,14 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
   if (!b.model->surfaceMesh) return;
   const double margin = bodyMargin(bodies, i, j, h);
   if (!withinMargin(bodies, i, j, margin)) return;
+  // A side with soft contacts is its deformed surface: a's vertex where its deformation moved it, b's
+  // surface moved where its nearest vertex moved along the normal.
+  const bool softA = a.modeCompliance != nullptr, softB = b.modeCompliance != nullptr;
   for (int n = 0; n < a.surfaceCount; ++n) {
     const int v = a.surfaceVertices[n];
     double p[3], depth, normal[3];
     int otherVertex = 0;
-    worldVertex(a, v, false, p);
+    worldVertex(a, v, softA, p);
     const double reach = keptReach(list, margin, a.contactSlop);
     if (!bodyDistance(b, p, reach, depth, normal, &otherVertex) || depth > reach) continue;
     double own[3];
@@ -507,20 +548,29 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
     const bool facing = pressFacing(a, v, margin, h, depth, normal, own, [&](double& d, double nf[3]) {
       return bodyDistance(b, p, margin, d, nf, &facingVertex, own);
     });
-    if (depth > reach) continue;
     if (facing) otherVertex = facingVertex;
+    const auto moved = [&] {  // b's nearest vertex along the normal
+      double u[3], uWorld[3];
+      b.model->vertexLinear(otherVertex, b.q, u, nullptr);
+      b.frame.toWorldDirection(u, uWorld);
+      return dot3(uWorld, normal);
+    };
+    if (softB) depth -= moved();
+    if (depth > reach) continue;
     Contact* ct = admit(list, bodies[i], i, j, -1, n, depth);
     if (!ct) continue;
     ct->otherVertex = otherVertex;
     ct->friction = material.friction, ct->restitution = material.restitution;
-    // Reported: the deformed vertex against the other's surface, moved where the other's nearest
-    // vertex moved along the normal (both deform).
-    double deformed[3], ignored[3], u[3], uWorld[3];
-    worldVertex(a, v, true, deformed);
-    bodyDistance(b, deformed, INFINITY, ct->deformedDepth, ignored, nullptr, facing ? own : nullptr);
-    b.model->vertexLinear(otherVertex, b.q, u, nullptr);
-    b.frame.toWorldDirection(u, uWorld);
-    ct->deformedDepth -= dot3(uWorld, normal);
+    // Reported: the deformed vertex against the other's deformed surface.
+    ct->deformedDepth = depth;
+    if (!softA) {
+      double deformed[3], ignored[3];
+      worldVertex(a, v, true, deformed);
+      bodyDistance(b, deformed, INFINITY, ct->deformedDepth, ignored, nullptr, facing ? own : nullptr);
+      ct->deformedDepth -= moved();
+    } else if (!softB) {
+      ct->deformedDepth -= moved();
+    }
     for (int k = 0; k < 3; ++k) {
       ct->point[k] = p[k], ct->normal[k] = normal[k];
       ct->arm[k] = p[k] - a.frame.position[k];
@@ -702,7 +752,8 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
   // Contacts: each surface vertex of the rest shape carried by the frame. Found and solved on the
   // rigid shape: the deformation takes the forces but does not move the contacts (taking its
   // vertices made the loads on q and the contacts chase each other: a resting bar fluttered, bent
-  // 1.5 cm, its contacts hopping between its ends and its middle every few steps).
+  // 1.5 cm, its contacts hopping between its ends and its middle every few steps). Soft contacts
+  // take its vertices, and solve its deformation with them (contact.h).
   const auto find = [&] {
     for (int i = 0; i < bodyCount; ++i) {
       if (!list.reducing) bodies[i].firstPair = bodies[i].pairEnd = list.pairCount;
@@ -730,7 +781,10 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
   std::sort(list.contacts, list.contacts + list.count, keyBefore);
   keepConsistentPushes(bodies, list, h);
 
-  // The relative velocity at a contact: body's frame less the other's (or the collider's surface).
+  // The relative velocity at a contact: body's frame less the other's (or the collider's surface),
+  // and where the impulses so far move each side's deformation. Friction holds the deformed
+  // vertices too: holding the frames only, it loaded q with impulses that did not stop its
+  // vertices, and a bar at rest pumped its deformation up (|q| 50x) and jittered.
   const auto relativeVelocity = [&](const Contact& ct, double out[3]) {
     bodyPointVelocity(bodies[ct.body], ct.arm, out);
     double other[3];
@@ -739,15 +793,37 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     } else {
       std::memcpy(other, ct.surfaceVelocity, sizeof other);
     }
+    double giving[3];
+    if (ct.rows) {
+      modeVelocityAt(*bodies[ct.body].instance, ct.rows, giving);
+      for (int a = 0; a < 3; ++a) out[a] += giving[a];
+    }
+    if (ct.otherRows) {
+      modeVelocityAt(*bodies[ct.other].instance, ct.otherRows, giving);
+      for (int a = 0; a < 3; ++a) out[a] -= giving[a];
+    }
     for (int a = 0; a < 3; ++a) out[a] -= other[a];
   };
   const auto effectiveMass = [&](const Contact& ct, const double n[3]) {
-    return 1.0 / (inverseMass(bodies[ct.body], ct.arm, n) + (ct.other >= 0 ? inverseMass(bodies[ct.other], ct.otherArm, n) : 0.0));
+    double inverse = inverseMass(bodies[ct.body], ct.arm, n) + (ct.other >= 0 ? inverseMass(bodies[ct.other], ct.otherArm, n) : 0.0);
+    if (ct.rows) inverse += modeGiving(*bodies[ct.body].instance, ct.rows, n);
+    if (ct.otherRows) inverse += modeGiving(*bodies[ct.other].instance, ct.otherRows, n);
+    return 1.0 / inverse;
   };
+  // An impulse on the frames and on the deformations where they give way.
   const auto apply = [&](const Contact& ct, const double J[3]) {
     applyImpulse(bodies[ct.body], ct.arm, J, 1);
     if (ct.other >= 0) applyImpulse(bodies[ct.other], ct.otherArm, J, -1);
+    if (ct.rows) pushModes(*bodies[ct.body].instance, ct.rows, J, 1);
+    if (ct.otherRows) pushModes(*bodies[ct.other].instance, ct.otherRows, J, -1);
   };
+  // A soft side's deformation moves without the contacts as well: predicted once per body that
+  // has some (an elastic evaluation each).
+  const auto predicted = [&](int body) {
+    ContactBody& b = bodies[body];
+    if (!b.modesPredicted) b.instance->predictContactModes(), b.modesPredicted = true;
+  };
+  for (int i = 0; i < bodyCount; ++i) bodies[i].modesPredicted = false;
   for (int j = 0; j < list.count; ++j) {
     Contact& ct = list.contacts[j];
     const qv_instance& s = *bodies[ct.body].instance;
@@ -757,10 +833,21 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     double vel[3];
     relativeVelocity(ct, vel);
     const double vn = dot3(vel, ct.normal);
+    ct.bounce = vn < -bounceSpeed ? -ct.restitution * vn : 0.0;
+    // Each side's deformation gives way where its vertex is a contact point of a body stepped
+    // implicitly: the contact then holds the deformed surface, not the rigid shape. Not in a
+    // bounce: restitution is the frames' (the deformation giving way took up the rebound of an
+    // elastic hit between two bars, which then barely exchanged their speeds).
+    ct.rows = s.modeCompliance && !ct.bounce ? s.model->contactModes.rowsOf(ct.vertex, s.r) : nullptr;
+    if (ct.rows) predicted(ct.body);
+    if (ct.other >= 0 && !ct.bounce) {
+      const qv_instance& o = *bodies[ct.other].instance;
+      ct.otherRows = o.modeCompliance ? o.model->contactModes.rowsOf(ct.otherVertex, o.r) : nullptr;
+      if (ct.otherRows) predicted(ct.other);
+    }
     // Approach until the surfaces meet, no further; push out what penetrates beyond the slop.
     const double pushOut = 0.2 * (-ct.depth - slop) / h;
     ct.target = ct.depth > slop ? -ct.depth / h : deep(ct, s, h) ? std::fmin(pushOut, kMaxPushOut) : pushOut;
-    ct.bounce = vn < -bounceSpeed ? -ct.restitution * vn : 0.0;
     ct.normalMass = effectiveMass(ct, ct.normal);
     ct.restingImpulse = 4 * ct.normalMass * (norm3(s.frame.gravity) * h + slop / h);
     // Tangents: the sliding direction first (any, when not sliding).

@@ -23,6 +23,11 @@
 //   stiffness to tune. The frames' velocities alone (not the deformation's) enter: impulses on the
 //   frame cannot change the deformation's, and chasing it pumped energy; a kinematic collider's
 //   surface velocity does;
+// - with soft contacts (qv_instance_config::soft_contacts), a body's contacts hold its deformed
+//   vertices, and its deformation enters as well, as the implicit step will move it: its motion
+//   without new contact forces (qv_instance::predictContactModes()), and each impulse's through
+//   the step's compliance, diagonal in the model's contact modes (contact_modes.h); not in a
+//   bounce, which stays the frames';
 // - the same impulses, over the step, act on q as vertex forces (so the object squashes where it
 //   lands and sags where it rests), a bounded load for the implicit step; less the bounce, which the
 //   restitution already returns to the frame (loading q with it too made a bounce gain 31%). The
@@ -47,6 +52,7 @@ struct ContactBody {
   double ownSpeed = 0, touchSpeed = 0, groupSpeed = 0;
   bool wakes = false;
   bool nearMovingCollider = false;  // one with a velocity is within its reach
+  bool modesPredicted = false;      // soft contacts: its deformation's motion predicted this solve
 };
 
 // Friction and restitution between two instances (a collider brings its own).

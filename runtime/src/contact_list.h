@@ -17,7 +17,8 @@ struct Contact {
   double point[3] = {}, normal[3] = {};  // normal: out of the collider or the other body
   double arm[3] = {}, otherArm[3] = {};  // point - x of body and of other
   double surfaceVelocity[3] = {};        // a kinematic collider's at the point
-  double depth = 0;          // signed distance of the rigid shape's vertex (negative: penetrating)
+  double depth = 0;          // signed distance of the rigid shape's vertex, or with soft contacts of the
+                             // deformed vertex (to the other's deformed surface); negative: penetrating
   bool speculative = false;  // depth beyond the slop: not touching yet
   int slot = 0;              // in a full list, of two equally poor the lower slot goes first (admit())
   double deformedDepth = 0;  // of the deformed vertex, reported
@@ -30,6 +31,10 @@ struct Contact {
   double tangent[2][3] = {};
   double normalMass = 0, tangentMass[2] = {};
   double friction = 0, restitution = 0;
+  // Where a side's deformation gives way (contact_modes.h): its vertex's rows of U V; null without
+  // soft contacts on that side, and in a bounce.
+  const double* rows = nullptr;
+  const double* otherRows = nullptr;
 };
 
 // One body's candidate contacts with one collider or one other body in a step.

@@ -21,7 +21,9 @@ bool validConfig(const qv_model* model, const qv_instance_config* c) {
          c->time_step > 0 && std::isfinite(c->time_step) && c->newton_iterations >= 1 && c->rayleigh_alpha >= 0 &&
          c->rayleigh_beta >= 0 && c->max_constraints >= 0 && c->max_constraints <= 64 && c->max_displacement > 0 &&
          (c->free_flight == 0 || (c->free_flight == 1 && model->rigidBody)) && c->max_contacts >= 0 &&
-         c->max_contacts <= 4096;
+         c->max_contacts <= 4096 && (c->soft_contacts == 0 || (c->soft_contacts == 1 && c->free_flight == 1 &&
+                                                                c->integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES &&
+                                                                c->elasticity != QV_ELASTICITY_MODAL_WARPING));
 }
 
 void defaultConfig(qv_instance_config& config, const qv_model* model) {
@@ -43,6 +45,7 @@ void defaultConfig(qv_instance_config& config, const qv_model* model) {
   config.elasticity = QV_ELASTICITY_STVK;
   config.free_flight = 0;
   config.max_contacts = 64;
+  config.soft_contacts = 0;
 }
 
 size_t instanceBytes(const qv_model& model, const qv_instance_config& config) {
@@ -88,6 +91,15 @@ qv_instance* constructInstance(const qv_model& model, const qv_instance_config& 
     double d2 = 0;
     for (int a = 0; a < 3; ++a) d2 += std::pow(model.info.bbox_max[a] - model.info.bbox_min[a], 2);
     s->contactSlop = 1e-3 * std::sqrt(d2);
+    if (s->modeCompliance) {
+      // An implicit step's end x moves by (w I + K + s C)^-1 f under a force f (K and C's stiffness
+      // D taken as K(0) here); an impulse P over the step is f = P / h, and x / h is the velocity.
+      const double h = config.time_step;
+      const StepPredictor p = implicitPredictor(config);
+      for (int i = 0; i < s->r; ++i)
+        s->modeCompliance[i] = 1 / (h * h * (p.w + p.s * config.rayleigh_alpha +
+                                              (1 + p.s * config.rayleigh_beta) * model.contactModes.stiffness[i]));
+    }
   }
   s->rest();
   return s;
@@ -123,6 +135,10 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
   if (flying()) {
     frame.attach(c.take<double>(quiver::rt::RigidFrame::scratchDoubles(r)), r);
     startQ = c.take<double>(r);
+    if (config.soft_contacts && model->contactModes.stiffness) {
+      modeCompliance = c.take<double>(r);
+      modeVelocity = c.take<double>(r);
+    }
     contacts.contacts = c.take<quiver::rt::Contact>(static_cast<size_t>(config.max_contacts));
     contacts.previous = c.take<quiver::rt::Contact>(static_cast<size_t>(config.max_contacts));
     contacts.pairs = c.take<quiver::rt::ContactPair>(static_cast<size_t>(config.max_contacts));
@@ -206,6 +222,28 @@ void qv_instance::beginStep() {
   for (int j = 0; j < r; ++j)
     loads.frameForce[j] += model->gravity[j] * body[0] + model->gravity[r + j] * body[1] + model->gravity[2 * r + j] * body[2];
   frame.accelerate(*model, h);
+}
+
+void qv_instance::predictContactModes() {
+  // The step's end x = q + d solves H d = w p - (R(q) + S(q) - f) - C v0 + s C p (the integrator's
+  // equation linearised at q, its predictor qt = q + p and v0), H = w I + K + s C, which is
+  // diagonal in the contact modes with K = K(0): d_i / h = c_i h (rhs)_i.
+  const double h = config.time_step;
+  const bool newmark = config.integrator == QV_INTEGRATOR_IMPLICIT_NEWMARK;
+  const quiver::rt::StepPredictor p = quiver::rt::implicitPredictor(config);
+  double* resisting = work.trial;  // free until the step
+  quiver::rt::evaluateElasticity(*model, config.elasticity, q, nullptr, resisting, nullptr, work.polynomialScratch);
+  loads.addStateForces(q, resisting);
+  for (int j = 0; j < r; ++j) resisting[j] -= loads.external(j);
+  const double* V = model->contactModes.vectors;
+  for (int i = 0; i < r; ++i) {
+    double vi = 0, ai = 0, fi = 0;
+    for (int j = 0; j < r; ++j) vi += V[j * r + i] * v[j], ai += V[j * r + i] * a[j], fi += V[j * r + i] * resisting[j];
+    const double C = config.rayleigh_alpha + config.rayleigh_beta * model->contactModes.stiffness[i];
+    const double step = newmark ? h * vi + 0.25 * h * h * ai : h * vi;
+    const double start = newmark ? vi + 0.5 * h * ai : vi;
+    modeVelocity[i] = modeCompliance[i] * h * (p.w * step - fi - C * start + p.s * C * step);
+  }
 }
 
 void qv_instance::solveOwnContacts() {

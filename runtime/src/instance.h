@@ -103,6 +103,13 @@ struct qv_instance {
   double stillTime = 0;
   int sleepGroup = -1;
   double* startQ = nullptr;  // in flight: q at a world step's start, to measure how far it moved q
+  // With soft contacts (config.soft_contacts): how far the step moves each of the model's contact modes
+  // (contact_modes.h) per unit impulse along it, over h (a velocity), 1 / (h^2 (w + s alpha +
+  // (1 + s beta) lambda)) with the integrator's w and s (incremental_potential.h); null otherwise.
+  // modeVelocity: the modes' velocity over the step in a contact solve, from predictContactModes()
+  // and the impulses since.
+  double* modeCompliance = nullptr;
+  double* modeVelocity = nullptr;
 
   void carve(quiver::rt::BlockCarver& c);
   void rest();
@@ -116,6 +123,9 @@ struct qv_instance {
   // leave it: for a state set from outside (setState(), a fixed Newton step the minimiser takes over).
   void dampingStiffnessAtState(double* D) const;
   bool flying() const { return config.free_flight != 0; }
+  // How fast the step would move the contact modes under its loads so far, contact forces not yet
+  // among them (modeCompliance not null): the implicit step linearised at q, into modeVelocity.
+  void predictContactModes();
   void wake() { asleep = false, stillTime = 0; }
   // Its steps are the minimiser's, which keeps E(q), the energy slack and D from step to step.
   bool minimizes() const {

@@ -3,8 +3,8 @@
 // measured from the world positions (consistent mass, central differences) do not change, and a
 // perfectly plastic hit leaves both at half the speed; bars falling together do not fall into each
 // other when the lowest lands, and bars laid edge on edge stay level; a bar spawned through a cube
-// is pushed out without flying off; a pile of 20 dropped bars
-// comes to rest. Sleeping: a settled pile falls asleep where it rested (as the same pile awake
+// is pushed out without flying off; with soft contacts a soft bar lies straight on a slab; a pile
+// of 20 dropped bars comes to rest. Sleeping: a settled pile falls asleep where it rested (as the same pile awake
 // rests) and does not move; a bar dropped on a sleeping stack, a platform starting to move, a
 // push, new gravity and a ground taken away wake it, and pulling the lowest from a sleeping stack
 // lets the one above fall; nothing sleeps while it falls or vibrates, or beside a moving collider.
@@ -44,9 +44,10 @@ struct World {
     EXPECT_EQ(qv_world_create(&c, nullptr, &w), QV_OK);
   }
   ~World() { qv_world_destroy(w); }
-  qv_instance* add(const FreeBar& bar, double h, const qv_rigid_state& start, bool gravity) {
+  qv_instance* add(const FreeBar& bar, double h, const qv_rigid_state& start, bool gravity, bool softContacts = false) {
     qv_instance_config c = bar.config(h);
     c.rayleigh_alpha = 5;
+    c.soft_contacts = softContacts ? 1 : 0;
     bodies.push_back(std::make_unique<test::Instance>(bar.model, c));
     qv_instance* s = bodies.back()->s;
     EXPECT_EQ(qv_instance_set_rigid_state(s, &start), QV_OK);
@@ -556,6 +557,61 @@ TEST(World, ABarSpawnedThroughACubeIsPushedOutWithoutFlyingOff) {
   EXPECT_GT(std::max(std::fabs(out.x()), std::fabs(out.y())), 0.3);  // out of the cube's footprint
   EXPECT_NEAR(out.z(), 0.05, 0.01);                                    // on the ground beside it
   EXPECT_LT((centre(box) - Eigen::Vector3d(0, 0, 0.3)).norm(), 0.1);
+}
+
+// A soft bar lying on a slab that lies on the ground lies straight on it, as on the ground itself
+// (contact_test.cpp, WithSoftContactsASoftBarLiesStraightOnTheGround): the slab holds its whole
+// underside. Soft contacts on both (each gives way where the other pushes: a 3 m bar on a 3.2 m
+// slab, both at 1 MPa), and on the bar only (a 1 m bar of 5 cm on a slab short enough to lie flat
+// on contacts that hold its rigid shape).
+TEST(World, WithSoftContactsASoftBarLiesStraightOnASlab) {
+  const double h = 1.0 / 60;
+  FreeBar longSlab(16, {16, 3, 1}, {3.2, 0.6, 0.1}), longBar(16, {30, 1, 1}, {3, 0.1, 0.1});
+  FreeBar shortSlab(16, {6, 3, 1}, {1.2, 0.6, 0.1}), thinBar(16, {20, 1, 1}, {1, 0.05, 0.05});
+  struct Case {
+    const FreeBar &slab, &bar;
+    bool softSlab, softBar;
+  };
+  for (const Case& c : {Case{longSlab, longBar, false, false}, Case{longSlab, longBar, true, true},
+                        Case{shortSlab, thinBar, false, false}, Case{shortSlab, thinBar, false, true}}) {
+    World world;
+    world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0)};
+    world.setColliders();
+    const double length = c.bar.info.bbox_max[0], height = c.bar.info.bbox_max[2];
+    qv_instance* slab = world.add(c.slab, h, at(0.5 * c.slab.info.bbox_max[0], 0.3, 0.051), true, c.softSlab);
+    qv_instance* bar = world.add(c.bar, h, at(0.5 * c.slab.info.bbox_max[0], 0.3, 0.1 + height / 2 + 0.006), true, c.softBar);
+    double fastest = 0, slabFastest = 0;  // the fastest any vertex moved in a step of the last second
+    Eigen::MatrixXd slabBefore, barBefore;
+    for (int i = 0; i < 240; ++i) {
+      ASSERT_EQ(qv_world_step(world.w), 0);
+      const Eigen::MatrixXd slabNow = c.slab.positions(slab), barNow = c.bar.positions(bar);
+      if (i > 180) {
+        slabFastest = std::max(slabFastest, (slabNow - slabBefore).rowwise().norm().maxCoeff() / h);
+        fastest = std::max(fastest, (barNow - barBefore).rowwise().norm().maxCoeff() / h);
+      }
+      slabBefore = slabNow, barBefore = barNow;
+    }
+    const Eigen::MatrixXd x = c.bar.positions(bar);
+    const double* rest = qv_model_rest_positions(c.bar.model);
+    double low = INFINITY, high = -INFINITY;
+    for (int v = 0; v < c.bar.info.vertex_count; ++v)
+      if (rest[3 * v + 2] < 1e-9) low = std::min(low, x(v, 2)), high = std::max(high, x(v, 2));
+    std::printf("a %g m bar on a %g m slab, soft contacts on the slab %d, on the bar %d: the bar's underside between z = %.4g "
+                "and %.4g m (the slab's top at 0.1 m); over the last second the bar moved at most %.2g m/s, the slab %.2g m/s\n", length,
+                c.slab.info.bbox_max[0], c.softSlab, c.softBar, low, high, fastest, slabFastest);
+    if (!c.softBar) {
+      EXPECT_GT(high - low, 5e-3);  // it sags into the slab: 36 cm, and 8 mm
+      continue;
+    }
+    EXPECT_LT(high - low, 2e-3);
+    EXPECT_GT(low, 0.1 - 0.01);  // resting contacts sink about a slop on each side
+    EXPECT_LT(fastest, 1e-5);
+    // A slab on contacts that hold its rigid shape keeps its deformation fluttering under the bar
+    // (0.9 mm/s at its vertices, as under a bar without soft contacts); on soft contacts it is still.
+    if (c.softSlab) {
+      EXPECT_LT(slabFastest, 1e-5);
+    }
+  }
 }
 
 TEST(World, BadUseIsRefused) {

@@ -16,7 +16,7 @@ extern "C" {
 #endif
 
 #define QV_VERSION_MAJOR 0
-#define QV_VERSION_MINOR 10
+#define QV_VERSION_MINOR 11
 #define QV_VERSION_PATCH 0
 #define QV_VERSION_NUMBER (QV_VERSION_MAJOR * 10000 + QV_VERSION_MINOR * 100 + QV_VERSION_PATCH)
 
@@ -198,6 +198,10 @@ typedef struct qv_instance_config {
   int free_flight;           /* 1: the object flies in a moving frame (qv_rigid_state; needs has_rigid_body); default 0 */
   int max_contacts;          /* in flight: contact points solved per step, 0..4096; default 64. When more touch, each
                                 touching patch keeps a subset spread over it (docs/architecture.md, Contact) */
+  int soft_contacts;         /* in flight, stepped implicitly, not with modal warping: 1: contacts hold the deformed surface, and the contact solve
+                                lets the deformation give way where it pushes (a soft object rests flat instead of sagging
+                                through what holds it: docs/architecture.md, Contact); 0 (default): they hold the rigid
+                                shape the frame carries, and the deformation only takes their forces */
 } qv_instance_config;
 
 /* Defaults for `model` (pass NULL for model-independent defaults). */
@@ -325,7 +329,8 @@ QV_API qv_result qv_instance_set_rigid_state(qv_instance* instance, const qv_rig
 
 /* Colliders: static or moved by the game between steps. A flying instance touches them with its surface
    vertices: each step, velocity-level impulses on its frame (restitution, Coulomb friction; stiff at any time
-   step), found and solved on the rigid shape it carries, and the same forces on its deformation. At rest a
+   step), found and solved on the rigid shape it carries (or, with soft_contacts, on its deformed surface,
+   which gives way where they push), and the same forces on its deformation. At rest a
    vertex sinks by a slop of 1e-3 of the model's diagonal, the contacts' slight softness and its own
    deformation: 1.5 mm (2.4e-3 of the diagonal) on tests/runtime/contact_test.cpp's soft bar at 1/60 s.
    Nothing moving faster than the step can see tunnels: a vertex is caught while its frame's (and the
@@ -376,8 +381,8 @@ typedef struct qv_contact {
   double normal[3];
   double impulse[3];  /* over the step, on this object: divide by the time step for the force */
   double depth;       /* the deformed vertex's signed distance at the step's start: negative where it penetrated
-                         (contacts are found and solved on the rigid shape the frame carries; the deformation
-                         takes their forces and may sink a vertex by its own displacement) */
+                         (contacts are found and solved on the rigid shape the frame carries, unless soft_contacts;
+                         the deformation takes their forces and may sink a vertex by its own displacement) */
   int instance;       /* in a world: the index (qv_world_add's order) of the instance whose vertex it is */
   int other;          /* in a world: the index of the instance it touched, -1 for a collider */
 } qv_contact;

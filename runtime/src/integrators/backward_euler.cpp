@@ -19,7 +19,7 @@ qv_step_status minimizing(qv_instance& s) {
     s.work.predictor[i] = s.end.q[i] = q[i] + h * v[i];  // qt, and the guess
     s.work.predictorVelocity[i] = v[i];
   }
-  const qv_step_status status = minimizeStep(s, StepPredictor{1 / (h * h), 1 / h, h});
+  const qv_step_status status = minimizeStep(s, backwardEulerPredictor(h));
   for (int i = 0; i < r; ++i) {
     a[i] = (s.end.v[i] - v[i]) / h;
     v[i] = s.end.v[i];

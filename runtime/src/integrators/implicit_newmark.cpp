@@ -18,7 +18,7 @@ StepPredictor beginNewmarkMinimization(qv_instance& s) {
     s.work.predictorVelocity[i] = v[i] + 0.5 * h * a[i];
     s.end.q[i] = newmarkGuess(s, i);
   }
-  return StepPredictor{4 / (h * h), 2 / h, h};
+  return newmarkPredictor(h);
 }
 
 qv_step_status endNewmarkMinimization(qv_instance& s, const StepPredictor& p, qv_step_status status) {

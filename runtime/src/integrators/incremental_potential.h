@@ -32,6 +32,13 @@ struct StepPredictor {
   double h;  // the time step
 };
 
+inline StepPredictor newmarkPredictor(double h) { return {4 / (h * h), 2 / h, h}; }
+inline StepPredictor backwardEulerPredictor(double h) { return {1 / (h * h), 1 / h, h}; }
+// Of an implicit integrator's steps (backward Euler's or implicit Newmark's).
+inline StepPredictor implicitPredictor(const qv_instance_config& c) {
+  return c.integrator == QV_INTEGRATOR_BACKWARD_EULER ? backwardEulerPredictor(c.time_step) : newmarkPredictor(c.time_step);
+}
+
 // Phi's Hessian w I + K(x) + J + s C, the matrix of each Newton direction (before any shift);
 // fused explicitly, as newtonSystem() (dynamics.h).
 inline SystemScales minimizerSystem(const qv_instance& s, const StepPredictor& p) {
