@@ -29,6 +29,8 @@ void SimOptions::addScenarioTo(CLI::App& app) {
   app.add_option("--stiffness", stiffness, "Drag: penalty spring per vertex, N/m")->capture_default_str();
   app.add_flag("--gravity", gravity, "Gravity, 9.81 m/s^2 along -z");
   app.add_flag("--free", step.freeFlight, "Fly: rigid motion with the deformation (a model baked with no fixed vertex)");
+  app.add_flag("--soft-contacts", step.softContacts,
+               "Free flight: contacts hold the deformed surface, which gives way where they push (soft objects rest flat)");
   flight.addTo(app);
   app.add_option("--dt", step.timeStep, "Time step, s")->check(Positive);
   app.add_option("--newton", step.newton,

@@ -75,7 +75,7 @@ qv_instance_config instanceConfig(const Model& model, const std::optional<std::s
                                   std::optional<double> timeStep, std::optional<int> newtonIterations,
                                   std::optional<double> newtonTolerance, std::optional<double> alpha, std::optional<double> beta,
                                   std::optional<int> maxConstraints, std::optional<double> maxDisplacement, bool freeFlight,
-                                  std::optional<int> maxContacts) {
+                                  std::optional<int> maxContacts, bool softContacts) {
   qv_instance_config c;
   qv_instance_config_init(&c, model.get());
   c.integrator = choice(integrator, c.integrator, qv_integrator_from_name, "integrator", QV_INTEGRATOR_COUNT, qv_integrator_name);
@@ -90,6 +90,7 @@ qv_instance_config instanceConfig(const Model& model, const std::optional<std::s
   c.max_displacement = maxDisplacement.value_or(c.max_displacement);
   c.free_flight = freeFlight ? 1 : 0;
   c.max_contacts = maxContacts.value_or(c.max_contacts);
+  c.soft_contacts = softContacts ? 1 : 0;
   require(c.time_step > 0 && std::isfinite(c.time_step), "time_step must be positive and finite");
   require(c.newton_iterations >= 1, "newton_iterations must be at least 1");
   require(c.newton_tolerance > 0 && std::isfinite(c.newton_tolerance), "newton_tolerance must be positive and finite");
@@ -99,6 +100,9 @@ qv_instance_config instanceConfig(const Model& model, const std::optional<std::s
   require(c.max_displacement > 0, "max_displacement must be positive");
   require(c.max_contacts >= 0 && c.max_contacts <= 4096, "max_contacts must be between 0 and 4096");
   require(!freeFlight || model.info().has_rigid_body, "free_flight needs a model baked free (info.has_rigid_body)");
+  require(!softContacts || (freeFlight && c.integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES &&
+                             c.elasticity != QV_ELASTICITY_MODAL_WARPING),
+          "soft_contacts needs free_flight=True, an implicit integrator ('newmark' or 'euler') and no modal warping");
   require(c.elasticity != QV_ELASTICITY_MODAL_WARPING || model.info().has_modal_rotations,
           "elasticity 'warping' needs a model with modal rotations (info.has_modal_rotations)");
   return c;
@@ -118,6 +122,7 @@ py::dict configDict(const qv_instance_config& c) {
   d["max_displacement"] = c.max_displacement;
   d["free_flight"] = c.free_flight != 0;
   d["max_contacts"] = c.max_contacts;
+  d["soft_contacts"] = c.soft_contacts != 0;
   return d;
 }
 
@@ -268,13 +273,14 @@ angular_velocity (rad/s, world axes). Each attribute reads as a new array and ta
 coordinates, C = alpha I + beta K (Rayleigh). Keeps its model alive.
 
 Instance(model, *, integrator, solver, elasticity, time_step, newton_iterations, newton_tolerance,
-rayleigh_alpha, rayleigh_beta, max_constraints, max_displacement, free_flight, max_contacts):
+rayleigh_alpha, rayleigh_beta, max_constraints, max_displacement, free_flight, max_contacts, soft_contacts):
 each keyword is a field of qv_instance_config; left out (None), it takes qv_instance_config_init's
 default: integrator 'newmark' (or 'euler', 'central'; see quiver.INTEGRATORS), solver 'minimize'
 (or 'newton'), elasticity 'stvk' (or 'linear', 'warping'), the model's time step and damping,
 newton_iterations 8, newton_tolerance 1e-6, max_constraints 4, max_displacement 100 x the model's
 diagonal, free_flight False (True: it flies in a moving frame; needs info.has_rigid_body),
-max_contacts 64.
+max_contacts 64, soft_contacts False (True, flying and stepped implicitly: contacts hold the
+deformed surface, which gives way where they push, so a soft object rests flat on what holds it).
 
 Vertex forces and the reduced force are per step (cleared by each step); gravity, constraints and
 colliders persist. Positions and normals are in the world (in flight, carried by the frame).)")
@@ -282,18 +288,19 @@ colliders persist. Positions and normals are in the world (in flight, carried by
                        const std::optional<std::string>& solver, const std::optional<std::string>& elasticity,
                        std::optional<double> timeStep, std::optional<int> newtonIterations, std::optional<double> newtonTolerance,
                        std::optional<double> alpha, std::optional<double> beta, std::optional<int> maxConstraints,
-                       std::optional<double> maxDisplacement, bool freeFlight, std::optional<int> maxContacts) {
+                       std::optional<double> maxDisplacement, bool freeFlight, std::optional<int> maxContacts,
+                       bool softContacts) {
              if (!model) throw py::type_error("model must be a quiver.Model");
              const qv_instance_config config = instanceConfig(*model, integrator, solver, elasticity, timeStep, newtonIterations,
                                                               newtonTolerance, alpha, beta, maxConstraints, maxDisplacement,
-                                                              freeFlight, maxContacts);
+                                                              freeFlight, maxContacts, softContacts);
              return std::make_unique<Instance>(std::move(model), config);
            }),
            py::arg("model"), py::kw_only(), py::arg("integrator") = py::none(), py::arg("solver") = py::none(),
            py::arg("elasticity") = py::none(), py::arg("time_step") = py::none(), py::arg("newton_iterations") = py::none(),
            py::arg("newton_tolerance") = py::none(), py::arg("rayleigh_alpha") = py::none(), py::arg("rayleigh_beta") = py::none(),
            py::arg("max_constraints") = py::none(), py::arg("max_displacement") = py::none(), py::arg("free_flight") = false,
-           py::arg("max_contacts") = py::none())
+           py::arg("max_contacts") = py::none(), py::arg("soft_contacts") = false)
       .def_property_readonly("model", [](const Instance& self) { return self.model; })
       .def_property_readonly("config", [](const Instance& self) { return configDict(self.config); },
                              "the qv_instance_config it was made with, as a dict (choices by name)")

@@ -71,6 +71,9 @@ RuntimeInstance::RuntimeInstance(const RuntimeModel& model, const qv_instance_co
                                  ? model.path() + " has no modal rotations (bake it again for modal warping)"
                              : config_.free_flight && !model.info().has_rigid_body
                                  ? model.path() + " was baked with fixed vertices: only a model baked free (no --fix) can fly"
+                             : config_.soft_contacts && (!config_.free_flight || config_.integrator == QV_INTEGRATOR_CENTRAL_DIFFERENCES ||
+                                                         config_.elasticity == QV_ELASTICITY_MODAL_WARPING)
+                                 ? "--soft-contacts needs --free, an implicit integrator (newmark or euler) and no modal warping"
                                  : "invalid simulation settings (time step, Newton iterations, damping)");
 }
 

@@ -18,6 +18,7 @@ struct StepSettings {
   qv_solver solver = QV_SOLVER_MINIMIZE;
   double alpha = -1, beta = -1;  // Rayleigh damping; negative: the model's
   bool freeFlight = false;       // the object flies (a model baked free): qv_instance_config::free_flight
+  bool softContacts = false;     // its contacts hold the deformed surface: qv_instance_config::soft_contacts
 
   bool operator==(const StepSettings& o) const;
 };

@@ -366,6 +366,7 @@ private:
       if (ImGui::InputDouble("damping beta, s", &beta, 0, 0, "%.4g", ImGuiInputTextFlags_EnterReturnsTrue))
         edited_.step.beta = std::max(beta, 0.0);
       ImGui::Checkbox("gravity", &edited_.gravity);
+      if (session_.flight()) ImGui::Checkbox("soft contacts", &edited_.step.softContacts);
       float spring = static_cast<float>(edited_.springStiffness);
       if (ImGui::SliderFloat("mouse spring, N/m", &spring, 1e-3f * spring + 1e-9f, 1e3f * spring, "%.3g",
                              ImGuiSliderFlags_Logarithmic))
@@ -455,6 +456,8 @@ int main(int argc, char** argv) {
   app.add_flag("--free", o.settings.step.freeFlight,
                "Fly a free model (baked with no fixed vertex): it drops onto the colliders, by default a ground plane "
                "under it as baked, from one height above it");
+  app.add_flag("--soft-contacts", o.settings.step.softContacts,
+               "With --free: contacts hold the deformed surface, which gives way where they push (soft objects rest flat)");
   o.flight.addTo(app);
   app.add_option("--frames", o.frames, "Run this many frames (1/60 s of simulation each), then exit")
       ->check(Positive);

@@ -64,7 +64,7 @@ void ViewSession::configure(const ViewSettings& wanted) {
   const bool same = next.integrator == now.integrator && next.time_step == now.time_step &&
                     next.newton_iterations == now.newton_iterations && next.rayleigh_alpha == now.rayleigh_alpha &&
                     next.rayleigh_beta == now.rayleigh_beta && next.elasticity == now.elasticity &&
-                    next.solver == now.solver;
+                    next.solver == now.solver && next.soft_contacts == now.soft_contacts;
   std::vector<double> q, v;  // the state a new instance continues from
   if (!same) {
     auto replacement = std::make_unique<RuntimeInstance>(model_, next);  // throws before anything changes

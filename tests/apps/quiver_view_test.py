@@ -146,6 +146,11 @@ class QuiverView(unittest.TestCase):
         piled = self.bodies(p.stdout)
         self.assertEqual(len(piled), 8)
         self.assertLess(max(np.linalg.norm(v) for _, v in piled), 0.01)
+        # With soft contacts, dropped the same way: at rest on its underside as well.
+        p = self.view("--free", "--soft-contacts", "--frames", 60, "--no-panel", model=FREE_MODEL)
+        (soft, velocity), = self.bodies(p.stdout)
+        self.assertAlmostEqual(soft[2], 0.05, delta=0.003)
+        self.assertLess(np.linalg.norm(velocity), 0.01)
 
     def test_bad_input_is_refused_without_a_screenshot(self):
         bad = os.path.join(self.tmp.name, "bad.txt")
@@ -156,7 +161,8 @@ class QuiverView(unittest.TestCase):
                               (["--drag-script", os.path.join(self.tmp.name, "none.txt")], "none.txt"),
                               (["--show-mode", "linear:99"], "--show-mode linear:99"),
                               (["--show-mode", "sideways:1"], "expected linear:N or basis:N"),
-                              (["--pile", 3], "need --free"), (["--free"], "was baked with fixed vertices")):
+                              (["--pile", 3], "need --free"), (["--free"], "was baked with fixed vertices"),
+                              (["--soft-contacts"], "--soft-contacts needs --free")):
             with self.subTest(args=args):
                 p = self.view("--frames", 5, "--screenshot", shot, *args)
                 self.assertEqual(p.returncode, 1, p.stderr)

@@ -83,6 +83,27 @@ def test_a_dropped_beam_comes_to_rest_on_the_ground(free_model, ground):
                                rtol=0, atol=0.02 * free_model.info.total_mass * G)
 
 
+def test_with_soft_contacts_a_beam_rests_flat_on_the_ground(free_model):
+    # The beam laid flat: its underside rests level (the ground holds all of it), sunk about a slop
+    # (1e-3 of its 0.62 m diagonal), and still.
+    s = quiver.Instance(free_model, free_flight=True, soft_contacts=True)
+    assert s.config["soft_contacts"] is True
+    state = s.rigid_state
+    state.position = [0.3, 0.05, 0.06]
+    s.rigid_state = state
+    s.set_gravity((0, 0, -G))
+    s.set_colliders([quiver.Plane((0, 0, 1), 0.0)])
+    s.step(180)
+    underside = s.positions()[free_model.rest_positions[:, 2] < 1e-9, 2]
+    assert -2 * 0.62e-3 < underside.min() and underside.max() - underside.min() < 2e-4, underside
+    assert np.abs(s.rigid_state.linear_velocity).max() < 1e-6
+    with pytest.raises(ValueError, match="soft_contacts needs free_flight"):
+        quiver.Instance(free_model, soft_contacts=True)
+    for bad in ({"integrator": "central"}, {"elasticity": "warping"}):
+        with pytest.raises(ValueError, match="an implicit integrator .* and no modal warping"):
+            quiver.Instance(free_model, free_flight=True, soft_contacts=True, **bad)
+
+
 def test_without_the_ground_it_falls_through(free_model):
     s = flyer(free_model, 0.3)
     s.set_colliders([quiver.Plane((0, 0, 1), 0.0)])
