@@ -6,9 +6,11 @@ median and 99th percentile of its wall time over 10 simulated seconds at 60 Hz, 
 groups that have come to rest sleep). Bakes the bar (0.6 x 0.1 x 0.1 m, E = 1 MPa, no fixed vertex,
 10 modes and their derivatives, r = 16) on 2 ranks. Then N bars apart on the ground (`--spread`:
 each touches the ground only, as objects scattered over a level), where the cost once they rest is
-what sleeping leaves: finding which bodies could touch.
+what sleeping leaves: finding which bodies could touch. Each world with the contacts on the bars'
+rigid shapes (the default) and with soft contacts (`--soft-contacts`: on their deformed surfaces,
+which give way where they push).
 
-    /usr/bin/python3 bench/world.py --build build/release [--piles 20,80,320] [--spread 1024]
+    /usr/bin/python3 bench/world.py --build build/release [--piles 20,80,320] [--spread 1024] [--contacts rigid,soft]
 """
 import argparse
 import json
@@ -27,7 +29,10 @@ def main():
     ap.add_argument("--build", default="build/release")
     ap.add_argument("--piles", default="20,80,320")
     ap.add_argument("--spread", type=int, default=1024)
+    ap.add_argument("--contacts", default="rigid,soft", help="comma-separated: rigid (the default contacts), soft")
     args = ap.parse_args()
+    if not set(args.contacts.split(",")) <= {"rigid", "soft"}:
+        ap.error(f"--contacts: expected rigid, soft or rigid,soft, not '{args.contacts}'")
     apps = os.path.join(args.build, "apps")
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -38,22 +43,24 @@ def main():
                         "--quiet", "-o", bar], check=True, env=ENV, stdin=subprocess.DEVNULL, capture_output=True)
         worlds = [(int(x), []) for x in args.piles.split(",")] + [(args.spread, ["--spread"])]
         for n, layout in worlds:
-            for sleep in ("0", "0.02"):
-                sim = subprocess.run([os.path.join(apps, "quiver"), "sim", bar + ".qvr", "--free", "--gravity", "--pile", str(n),
-                                      *layout, "--position", "0,0,0.2", "--collider", "plane:0,0,1,0", "--steps", str(STEPS),
-                                      "--sleep-speed", sleep, "--json"],
-                                     capture_output=True, text=True, stdin=subprocess.DEVNULL)
-                if sim.returncode not in (0, 2):  # 2: some step reset, which the table counts
-                    raise SystemExit(f"quiver sim --pile {n} failed ({sim.returncode}): {sim.stderr.strip()}")
-                rows.append((f"{n} apart" if layout else str(n), "off" if sleep == "0" else f"{sleep} m/s",
-                             json.loads(sim.stdout)))
+            for contacts in args.contacts.split(","):
+                for sleep in ("0", "0.02"):
+                    soft = ["--soft-contacts"] if contacts == "soft" else []
+                    sim = subprocess.run([os.path.join(apps, "quiver"), "sim", bar + ".qvr", "--free", "--gravity", "--pile", str(n),
+                                          *layout, *soft, "--position", "0,0,0.2", "--collider", "plane:0,0,1,0",
+                                          "--steps", str(STEPS), "--sleep-speed", sleep, "--json"],
+                                         capture_output=True, text=True, stdin=subprocess.DEVNULL)
+                    if sim.returncode not in (0, 2):  # 2: some step reset, which the table counts
+                        raise SystemExit(f"quiver sim --pile {n} failed ({sim.returncode}): {sim.stderr.strip()}")
+                    rows.append((f"{n} apart" if layout else str(n), contacts, "off" if sleep == "0" else f"{sleep} m/s",
+                                 json.loads(sim.stdout)))
     print(machine_line() + f"; one thread, {STEPS} steps of 1/60 s\n")
-    print("| bodies | sleeping | world step, median (ms) | 99th percentile (ms) | median per body (us) | asleep at the end "
-          "| fastest body at the end (m/s) | deepest deformed-vertex penetration (mm) | resets |")
-    print("|---:|---|---:|---:|---:|---:|---:|---:|---:|")
-    for n, sleep, j in rows:
+    print("| bodies | contacts | sleeping | world step, median (ms) | 99th percentile (ms) | median per body (us) "
+          "| asleep at the end | fastest body at the end (m/s) | deepest deformed-vertex penetration (mm) | resets |")
+    print("|---:|---|---|---:|---:|---:|---:|---:|---:|---:|")
+    for n, contacts, sleep, j in rows:
         bodies = j["bodies"]
-        print(f"| {n} | {sleep} | {j['step_us_median'] / 1e3:.2f} | {j['step_us_p99'] / 1e3:.1f} | {j['step_us_median'] / bodies:.1f} "
+        print(f"| {n} | {contacts} | {sleep} | {j['step_us_median'] / 1e3:.2f} | {j['step_us_p99'] / 1e3:.1f} | {j['step_us_median'] / bodies:.1f} "
               f"| {j['asleep_at_end']} | {j['max_final_speed_mps']:.1g} "
               f"| {j['max_penetration_m'] * 1e3:.0f} | {j['resets']} |")
 
