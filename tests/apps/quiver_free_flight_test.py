@@ -98,17 +98,23 @@ class FreeFlight(unittest.TestCase):
         self.assertLess(mesh["final_speed_mps"], 0.01)
         self.assertGreater(mesh["final_center"][2], 0.04)
 
+    def lay_public_bar(self, name, youngs, steps, *more):
+        """Polyfem's 10 x 0.5 x 1 m bar `name` (in ../shared/meshes) baked free at `youngs` Pa, laid on
+        the ground from 5 cm above it: `quiver sim --json` after `steps` steps of 1/60 s."""
+        mesh = os.path.join(SHARED, name)
+        if not os.path.exists(mesh):
+            self.skipTest(f"shared mesh absent ({mesh}): skipping polyfem's bar")
+        out = os.path.join(self.tmp.name, f"{name}-{youngs:g}")
+        if not os.path.exists(out + ".qvr"):
+            run(BAKE, mesh, "--E", youngs, "--nu", "0.4", "--density", "1000", "--modes", 12, "--rank", 20, "--quiet", "-o", out)
+        return json.loads(run(QUIVER, "sim", out + ".qvr", "--free", "--gravity", "--collider", "plane:0,0,1,0",
+                              "--position", "0,0,0.05", "--steps", steps, "--hold", 0, "--json", *more).stdout)
+
     def test_a_public_sliver_bar_rests_on_its_face(self):
         # Polyfem's 10 x 0.5 x 1 m bar baked free: 222 vertices of its underside touch the ground, more
         # than the 64 contacts an instance keeps. Keeping the deepest 64 made it rock about its long axis
         # for ever (0.03-0.09 m/s after 20 s); a spread subset of its face holds it still.
-        mesh = os.path.join(SHARED, "polyfem_bar-2523.msh")
-        if not os.path.exists(mesh):
-            self.skipTest(f"shared mesh absent ({mesh}): skipping the public sliver bar")
-        out = os.path.join(self.tmp.name, "sliver")
-        run(BAKE, mesh, "--E", "1e8", "--nu", "0.4", "--density", "1000", "--modes", 12, "--rank", 20, "--quiet", "-o", out)
-        j = json.loads(run(QUIVER, "sim", out + ".qvr", "--free", "--gravity", "--collider", "plane:0,0,1,0",
-                           "--position", "0,0,0.05", "--steps", 1200, "--hold", 0, "--json").stdout)
+        j = self.lay_public_bar("polyfem_bar-2523.msh", 1e8, 1200)
         print(f"sliver bar on its face after 20 s: {j['final_speed_mps']:.2g} m/s, centre {j['final_center']}")
         self.assertLess(j["final_speed_mps"], 1e-5)
         np.testing.assert_allclose(j["final_center"][:2], [5, 0.25], atol=1e-3)  # where it fell, not walked away
@@ -120,14 +126,8 @@ class FreeFlight(unittest.TestCase):
         # Polyfem's 10 x 0.5 x 1 m bar baked free at 1 MPa: so soft that, held at a few places, it would
         # sag metres. On contacts that hold its rigid shape it sags 1.2 m through the ground; with soft
         # contacts the ground holds its deformed underside, which lies on it.
-        mesh = os.path.join(SHARED, "polyfem_bar-651.msh")
-        if not os.path.exists(mesh):
-            self.skipTest(f"shared mesh absent ({mesh}): skipping the soft public bar")
-        out = os.path.join(self.tmp.name, "soft_bar")
-        run(BAKE, mesh, "--E", "1e6", "--nu", "0.4", "--density", "1000", "--modes", 12, "--rank", 20, "--quiet", "-o", out)
-        sim = lambda *more: json.loads(run(QUIVER, "sim", out + ".qvr", "--free", "--gravity", "--collider", "plane:0,0,1,0",
-                                           "--position", "0,0,0.05", "--steps", 600, "--hold", 0, "--json", *more).stdout)
-        rigid, soft = sim(), sim("--soft-contacts")
+        rigid = self.lay_public_bar("polyfem_bar-651.msh", 1e6, 600)
+        soft = self.lay_public_bar("polyfem_bar-651.msh", 1e6, 600, "--soft-contacts")
         print(f"soft bar after 10 s: sank {rigid['max_penetration_m']:.3g} m on rigid contacts, "
               f"{soft['max_penetration_m']:.3g} m on soft ones, then {soft['final_speed_mps']:.2g} m/s")
         self.assertGreater(rigid["max_penetration_m"], 0.5)
