@@ -16,14 +16,37 @@ namespace {
 constexpr int L = ReducedPolynomial::kLanes;
 
 
-// y[i] = sum_k B_ik q_k for the rows of a blocked matrix (ReducedPolynomial::kBlock): eight rows
-// per sweep, each coefficient broadcast against q_k's lanes into one of eight running sums. y has
-// room for the padding rows of the last block. float32 blocks are converted first into `block64`
-// (r kBlock doubles): converted one by one in the loop, each would cost two more instructions
-// per multiply-add.
+// Rows first..first+G-1 of one block of kBlock rows (`block`: [k][kBlock]) times q: each
+// coefficient broadcast against q_k's lanes into one of G running sums, kept in registers.
+template <size_t G>
+[[gnu::always_inline]] inline void blockRowsLanes(const double* block, size_t first, int r, const double* q,
+                                                  double* y) {
+  constexpr size_t B = ReducedPolynomial::kBlock;
+  double sum[G][L];  // set at k = 0: zeroing it first costs a memset per block
+  for (size_t g = 0; g < G; ++g)
+#pragma omp simd
+    for (int l = 0; l < L; ++l) sum[g][l] = block[first + g] * q[l];
+  for (int k = 1; k < r; ++k) {
+    const double* qk = q + k * L;
+    for (size_t g = 0; g < G; ++g)
+#pragma omp simd
+      for (int l = 0; l < L; ++l) sum[g][l] += block[k * B + first + g] * qk[l];
+  }
+  for (size_t g = 0; g < G; ++g)
+#pragma omp simd
+    for (int l = 0; l < L; ++l) y[(first + g) * L + l] = sum[g][l];
+}
+
+// y[i] = sum_k B_ik q_k for the rows of a blocked matrix (ReducedPolynomial::kBlock), k in order
+// whatever the rows swept together: a whole block per sweep with 32 vector registers (its eight
+// sums of eight lanes are eight AVX-512 registers), half a block otherwise (eight AVX2 registers;
+// sixteen spilled, and the sweep ran at half the FMA peak). y has room for the padding rows of the
+// last block. float32 blocks are converted first into `block64` (r kBlock doubles): converted one
+// by one in the loop, each would cost two more instructions per multiply-add.
 template <class C>
 QV_HOT void blockedProductLanes(const C* B, int r, size_t rows, const double* q, double* y, double* block64) {
-  constexpr size_t G = 8;
+  constexpr size_t G = ReducedPolynomial::kBlock;
+  const bool wholeBlocks = vectorRegisters32();
   for (size_t i = 0; i < rows; i += G) {
     const double* block;
     if constexpr (std::is_same_v<C, double>) {
@@ -33,19 +56,12 @@ QV_HOT void blockedProductLanes(const C* B, int r, size_t rows, const double* q,
       for (size_t j = 0; j < r * G; ++j) block64[j] = static_cast<double>(B[i * r + j]);
       block = block64;
     }
-    double sum[G][L];  // set at k = 0: zeroing it first costs a memset per block
-    for (size_t g = 0; g < G; ++g)
-#pragma omp simd
-      for (int l = 0; l < L; ++l) sum[g][l] = block[g] * q[l];
-    for (int k = 1; k < r; ++k) {
-      const double* qk = q + k * L;
-      for (size_t g = 0; g < G; ++g)
-#pragma omp simd
-        for (int l = 0; l < L; ++l) sum[g][l] += block[k * G + g] * qk[l];
+    if (wholeBlocks) {
+      blockRowsLanes<G>(block, 0, r, q, y + i * L);
+    } else {
+      blockRowsLanes<G / 2>(block, 0, r, q, y + i * L);
+      blockRowsLanes<G / 2>(block, G / 2, r, q, y + i * L);
     }
-    for (size_t g = 0; g < G; ++g)
-#pragma omp simd
-      for (int l = 0; l < L; ++l) y[(i + g) * L + l] = sum[g][l];
   }
 }
 
