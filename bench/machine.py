@@ -3,9 +3,19 @@ import ctypes
 
 
 def cpu_model():
-    """The CPU's model name as /proc/cpuinfo gives it."""
+    """The CPU's model name as /proc/cpuinfo gives it, with its family and model numbers and its widest
+    vectors: a virtual machine's name ("AMD EPYC") can stand for CPUs of different generations."""
+    fields = {}
     with open("/proc/cpuinfo") as f:
-        return next((line.split(":", 1)[1].strip() for line in f if line.startswith("model name")), "?")
+        for line in f:
+            if not line.strip():
+                break
+            key, _, value = line.partition(":")
+            fields[key.strip()] = value.strip()
+    flags = fields.get("flags", "").split()
+    vectors = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE"
+    return (f"{fields.get('model name', '?')} (family {fields.get('cpu family', '?')} model {fields.get('model', '?')}, "
+            f"{vectors})")
 
 
 def blas_core():
