@@ -497,11 +497,20 @@ void findColliderContacts(ContactBody* bodies, int i, const qv_collider* collide
     const int v = s.surfaceVertices[n];
     double p[3];
     worldVertex(s, v, deforms, p);
+    // A deformed vertex also moves with the deformation, which can outrun the frame many times (a
+    // bar's ends flung at the ground while it lies still).
+    double flex = 0;
+    if (deforms) {
+      double w[3];
+      s.model->vertexLinear(v, s.v, w, nullptr);
+      flex = norm3(w);
+    }
     for (int k = 0; k < count; ++k) {
       const qv_collider& col = colliders[k];
       double u[3], depth, normal[3];
       surfaceVelocity(col, p, u);
-      const double margin = s.contactSlop + 2 * h * std::fmax(relativeSpeed(bodies[i], u), bodies[i].groupSpeed);
+      const double margin =
+          s.contactSlop + 2 * h * std::fmax(relativeSpeed(bodies[i], u) + flex, bodies[i].groupSpeed);
       const double reach = keptReach(list, margin, s.contactSlop);
       if (!colliderDistance(col, p, reach, depth, normal) || depth > reach) continue;
       double own[3];
