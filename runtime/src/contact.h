@@ -24,10 +24,11 @@
 //   frame cannot change the deformation's, and chasing it pumped energy; a kinematic collider's
 //   surface velocity does;
 // - with soft contacts (qv_instance_config::soft_contacts), a body's contacts hold its deformed
-//   vertices, and its deformation enters as well, as the implicit step will move it: its motion
-//   without new contact forces (qv_instance::predictContactModes()), and each impulse's through
-//   the step's compliance, diagonal in the model's contact modes (contact_modes.h); not in a
-//   bounce, which stays the frames';
+//   vertices (against colliders, each one's margin covers its deformation's speed too; between
+//   bodies, the frames' alone), and its deformation enters as well, as the implicit step will
+//   move it: its motion without new contact forces (qv_instance::predictContactModes()), and each
+//   impulse's through the step's compliance, diagonal in the model's contact modes
+//   (contact_modes.h); not in a bounce, which stays the frames';
 // - the same impulses, over the step, act on q as vertex forces (so the object squashes where it
 //   lands and sags where it rests), a bounded load for the implicit step; less the bounce, which the
 //   restitution already returns to the frame (loading q with it too made a bounce gain 31%). The
