@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <utility>
 
 #include "formats/model/qvr.h"
 
@@ -30,72 +31,61 @@ double repeatFactor(const int (&idx)[N]) {
   return f;
 }
 
-size_t align8(size_t n) { return n & ~size_t(7); }
+// Q's upper triangle is stored in groups of eight rows (pairs p..p+7, p a multiple of 8), over the
+// pairs padded to whole groups (n = blockedRows(P), zeros beyond P): the group's rows all start at
+// column p and run to n, one after another, so every row is a whole number of 8-wide vectors.
+size_t groupOffset(size_t n, size_t p) { return p * n + 4 * p - p * p / 2; }  // sum of 8 (n - g), g < p
+size_t packedCount(size_t n) { return groupOffset(n, n); }
 
+// W values of T in one vector (GCC's vector extension: each clone maps it onto its own registers).
+template <class T, int W>
+struct Vector {
+  typedef T type __attribute__((vector_size(W * sizeof(T))));
+};
 
-size_t packedCount(size_t pairs) {
-  size_t total = 0;
-  for (size_t p = 0; p < pairs; ++p) total += pairs - align8(p);
-  return total;
+// W coefficients from `at` as a vector of doubles: written lane by lane, which GCC turns into one
+// vcvtps2pd from memory (its __builtin_convertvector converted two halves and reassembled them).
+template <class Vd, class C, int... I>
+[[gnu::always_inline]] inline void widen(const C* at, std::integer_sequence<int, I...>, Vd& v) {
+  v = Vd{static_cast<double>(at[I])...};  // by reference: returned, a vector's ABI depends on the clone
 }
 
 // y[s] += Q[p][s] x[p] for s > p and y[p] += sum_s Q[p][s] x[s]: one pass over row p of the upper
-// triangle does both halves of the symmetric product (the stored diagonal is halved). The rows of
-// one 8-aligned group start at the same column and have the same length, so one sweep updates y
-// once for all eight and reads x once: per coefficient, one multiply-add into its row's dot
-// product and one into y, with y's load and store shared by eight of them.
-template <class C>
-QV_HOT void packedSymmetricProduct(const C* Q, const size_t* rowStart, const size_t* rowOffset, size_t n,
-                                   const double* x, double* y) {
+// triangle does both halves of the symmetric product (the stored diagonal is halved). A group's
+// eight rows are swept together, W columns at a time, so y is loaded and stored and x read once
+// for all eight: per coefficient, one multiply-add into its row's dot product and one into y.
+// Written with vectors of W doubles: W = 4 where 16 vector registers must hold the eight dot
+// products, the eight x[p] and the converted coefficients; left to the vectoriser, float32
+// coefficients made it sweep eight columns at a time and spill every dot product to the stack.
+template <int W, class C>
+QV_HOT void packedSymmetricProduct(const C* Q, size_t n, const double* x, double* y) {
+  using Vd = typename Vector<double, W>::type;
   constexpr size_t G = 8;
   for (size_t s = 0; s < n; ++s) y[s] = 0;
-  size_t p = 0;
-  for (; p + G <= n; p += G) {
-    const size_t start = rowStart[p];
-    const C* row[G];
-    double xp[G];
+  for (size_t p = 0; p < n; p += G) {
+    const size_t length = n - p;
+    const C* row = Q + groupOffset(n, p);
+    Vd dot[G], xp[G];
     for (size_t g = 0; g < G; ++g) {
-      row[g] = Q + rowOffset[p + g] - start;
-      xp[g] = x[p + g];
+      dot[g] = Vd{};
+      xp[g] = Vd{} + x[p + g];
     }
-    double d0 = 0, d1 = 0, d2 = 0, d3 = 0, d4 = 0, d5 = 0, d6 = 0, d7 = 0;
-#pragma omp simd reduction(+ : d0, d1, d2, d3, d4, d5, d6, d7)
-    for (size_t s = start; s < n; ++s) {
-      const double c0 = static_cast<double>(row[0][s]), c1 = static_cast<double>(row[1][s]);
-      const double c2 = static_cast<double>(row[2][s]), c3 = static_cast<double>(row[3][s]);
-      const double c4 = static_cast<double>(row[4][s]), c5 = static_cast<double>(row[5][s]);
-      const double c6 = static_cast<double>(row[6][s]), c7 = static_cast<double>(row[7][s]);
-      const double xs = x[s];
-      d0 += c0 * xs;
-      d1 += c1 * xs;
-      d2 += c2 * xs;
-      d3 += c3 * xs;
-      d4 += c4 * xs;
-      d5 += c5 * xs;
-      d6 += c6 * xs;
-      d7 += c7 * xs;
-      y[s] += (c0 * xp[0] + c1 * xp[1] + c2 * xp[2] + c3 * xp[3]) + (c4 * xp[4] + c5 * xp[5] + c6 * xp[6] + c7 * xp[7]);
+    for (size_t s = 0; s < length; s += W) {
+      Vd xs, ys, c, half[2];
+      std::memcpy(&xs, x + p + s, sizeof xs);
+      // Row by row, so that one converted coefficient vector is live at a time (all eight at once
+      // left no register for the eighth dot product).
+      for (size_t g = 0; g < G; ++g) {
+        widen(row + g * length + s, std::make_integer_sequence<int, W>(), c);
+        dot[g] += c * xs;
+        half[g / 4] = g % 4 ? half[g / 4] + c * xp[g] : c * xp[g];
+      }
+      std::memcpy(&ys, y + p + s, sizeof ys);
+      ys += half[0] + half[1];
+      std::memcpy(y + p + s, &ys, sizeof ys);
     }
-    y[p] += d0;
-    y[p + 1] += d1;
-    y[p + 2] += d2;
-    y[p + 3] += d3;
-    y[p + 4] += d4;
-    y[p + 5] += d5;
-    y[p + 6] += d6;
-    y[p + 7] += d7;
-  }
-  for (; p < n; ++p) {
-    const C* row = Q + rowOffset[p] - rowStart[p];
-    const double xp = x[p];
-    double dot = 0;
-#pragma omp simd reduction(+ : dot)
-    for (size_t s = rowStart[p]; s < n; ++s) {
-      const double c = static_cast<double>(row[s]);
-      dot += c * x[s];
-      y[s] += c * xp;
-    }
-    y[p] += dot;
+    for (size_t g = 0; g < G; ++g)
+      for (int w = 0; w < W; ++w) y[p + g] += dot[g][w];
   }
 }
 
@@ -126,12 +116,10 @@ ReducedPolynomial::Arrays ReducedPolynomial::carve(BlockCarver& c, bool single, 
   Arrays a{};
   a.k2 = c.take<double>(pairs_);
   a.t = c.take<double>(static_cast<size_t>(r_) * blockedRows(pairs_));
-  a.rowStart = c.take<size_t>(pairs_);
-  a.rowOffset = c.take<size_t>(pairs_);
   if (single)
-    a.q32 = c.take<float>(packedCount(pairs_));
+    a.q32 = c.take<float>(packedCount(blockedRows(pairs_)));
   else
-    a.q64 = c.take<double>(packedCount(pairs_));
+    a.q64 = c.take<double>(packedCount(blockedRows(pairs_)));
   if (!groups) return a;
   const size_t d = static_cast<size_t>(r_) * blockedRows(triples_);
   if (single)
@@ -157,7 +145,7 @@ size_t ReducedPolynomial::storageBytes(int r, bool single, bool groups) { return
 size_t ReducedPolynomial::evaluationBytes(int r, bool single) { return measure(r, single, false); }
 
 size_t ReducedPolynomial::scratchSize(int r) {
-  return monomialCount2(r) * 2 + blockedRows(monomialCount2(r)) + static_cast<size_t>(r);
+  return blockedRows(monomialCount2(r)) * 3 + static_cast<size_t>(r);
 }
 
 void ReducedPolynomial::build(int r, const double* c, bool single, bool groups, void* storage) {
@@ -170,14 +158,8 @@ void ReducedPolynomial::build(int r, const double* c, bool single, bool groups, 
   std::memset(storage, 0, carver.size());
   double* k2 = arrays.k2;
   double* t = arrays.t;
-  size_t* rowStart = arrays.rowStart;
-  size_t* rowOffset = arrays.rowOffset;
   void* Q = single ? static_cast<void*>(arrays.q32) : static_cast<void*>(arrays.q64);
-  for (size_t p = 0, offset = 0; p < P; ++p) {
-    rowStart[p] = align8(p);
-    rowOffset[p] = offset;
-    offset += P - rowStart[p];
-  }
+  const size_t padded = blockedRows(P);
   auto setQ = [&](size_t p, size_t s, double value) {
     if (s < p) {
       const size_t x = p;
@@ -185,7 +167,8 @@ void ReducedPolynomial::build(int r, const double* c, bool single, bool groups, 
       s = x;
     }
     if (s == p) value *= 0.5;  // the product visits the diagonal twice
-    const size_t at = rowOffset[p] + (s - rowStart[p]);
+    const size_t first = p / kBlock * kBlock;  // the group's first pair, and its rows' first column
+    const size_t at = groupOffset(padded, first) + (p - first) * (padded - first) + (s - first);
     if (single)
       static_cast<float*>(Q)[at] = static_cast<float>(value);
     else
@@ -243,8 +226,6 @@ void ReducedPolynomial::build(int r, const double* c, bool single, bool groups, 
   d64_ = arrays.d64;
   d32_ = arrays.d32;
   tripleOf_ = arrays.tripleOf;
-  rowStart_ = arrays.rowStart;
-  rowOffset_ = arrays.rowOffset;
   q64_ = arrays.q64;
   q32_ = arrays.q32;
 }
@@ -253,16 +234,20 @@ void ReducedPolynomial::evaluate(const double* q, double* energy, double* force,
                                  double* scratch) const {
   const int r = r_;
   const size_t P = pairs_;
-  double* x = scratch;               // w_kl q_k q_l
-  double* y3 = x + P;                // K_3(q) per pair
-  double* y4 = y3 + blockedRows(P);  // K_4(q) per pair
-  double* Rq = y4 + P;               // r
-  for (int k = 0, s = 0; k < r; ++k)
+  const size_t n = blockedRows(P);
+  double* x = scratch;  // w_kl q_k q_l, then zeros to n
+  double* y3 = x + n;   // K_3(q) per pair
+  double* y4 = y3 + n;  // K_4(q) per pair
+  double* Rq = y4 + n;  // r
+  size_t s = 0;
+  for (int k = 0; k < r; ++k)
     for (int l = k; l < r; ++l) x[s++] = (k == l ? 0.5 : 1.0) * q[k] * q[l];
+  for (; s < n; ++s) x[s] = 0;
+  const bool wide = vectorRegisters32();
   if (q32_)
-    packedSymmetricProduct(q32_, rowStart_, rowOffset_, P, x, y4);
+    wide ? packedSymmetricProduct<8>(q32_, n, x, y4) : packedSymmetricProduct<4>(q32_, n, x, y4);
   else
-    packedSymmetricProduct(q64_, rowStart_, rowOffset_, P, x, y4);
+    wide ? packedSymmetricProduct<8>(q64_, n, x, y4) : packedSymmetricProduct<4>(q64_, n, x, y4);
   blockedProduct(t_, r, P, q, y3);
   for (int i = 0; i < r; ++i) Rq[i] = 0;
   double e = 0;

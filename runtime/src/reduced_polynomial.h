@@ -5,11 +5,12 @@
 // unique monomial coefficients. At load time they become the stiffness polynomial
 //   K_ab(q) = k2_ab + sum_k T_abk q_k + sum_{k<=l} Q_ab,kl w_kl q_k q_l       (pairs a <= b)
 // whose three parts are the Hessians of E_2, E_3 and E_4 (w_kl = 1/2 on the diagonal, 1 off it).
-// Q, indexed by pairs on both sides, is symmetric, so only its upper triangle is stored, row by
-// row, and one pass over it does both halves of the product (a packed symmetric matrix-vector
-// product). At r = 30 that is 108k coefficients: 0.87 MB in float64, 0.43 MB in float32, both
-// cache-resident. Euler's theorem for homogeneous functions then gives the force and the energy
-// from the same parts, with no second pass:
+// Q, indexed by pairs on both sides, is symmetric, so only its upper triangle is stored, in groups
+// of eight rows, and one pass over it does both halves of the product (a packed symmetric
+// matrix-vector product). At r = 30 that is 113k coefficients: 0.91 MB in float64, 0.45 MB in
+// float32 (a Zen 3's 512 KiB L2 holds neither with the rest: it streams them from L3). Euler's
+// theorem for homogeneous functions then gives the force and the energy from the same parts, with
+// no second pass:
 //   R(q) = (K_2 + K_3(q)/2 + K_4(q)/3) q,   E(q) = q^T (K_2/2 + K_3(q)/6 + K_4(q)/12) q.
 //
 // Groups of states (evaluateLanes), where the arithmetic, not the memory, bounds the work, contract
@@ -72,8 +73,6 @@ private:
   struct Arrays {
     double* k2;
     double* t;
-    size_t* rowStart;
-    size_t* rowOffset;
     double* q64;
     float* q32;
     double* d64;
@@ -94,9 +93,7 @@ private:
   const double* k2_ = nullptr;   // [pair]
   size_t triples_ = 0;           // C(r+2, 3), for i <= j <= k
   const double* t_ = nullptr;    // T_abk, rows (a <= b) blocked over k: K_3 = t_ q
-  const size_t* rowStart_ = nullptr;  // [pair]: where row p of Q begins (its first column, 8-aligned)
-  const size_t* rowOffset_ = nullptr; // [pair]: its offset in the coefficient array
-  const double* q64_ = nullptr;  // Q's upper triangle (diagonal halved), float64, or null
+  const double* q64_ = nullptr;  // Q's upper triangle (diagonal halved; groups of eight rows), float64, or null
   const float* q32_ = nullptr;   // the same in float32, or null
   const double* d64_ = nullptr;  // D_ijkl / 2, rows (i <= j <= k) blocked over l, float64, or null
   const float* d32_ = nullptr;   // the same in float32, or null
