@@ -32,10 +32,17 @@ double repeatFactor(const int (&idx)[N]) {
 }
 
 // Q's upper triangle is stored in groups of eight rows (pairs p..p+7, p a multiple of 8), over the
-// pairs padded to whole groups (n = blockedRows(P), zeros beyond P): the group's rows all start at
-// column p and run to n, one after another, so every row is a whole number of 8-wide vectors.
+// pairs padded to whole groups (n = blockedRows(P), zeros beyond P). The group's rows all start at
+// column p and run to n, and are interleaved eight columns at a time, [column / 8][row][column % 8],
+// so that a sweep over the group reads one sequential stream (eight streams, one per row, had cost
+// 10-15% at r = 30 and 40 with the coefficients in L3) and has no tail.
 size_t groupOffset(size_t n, size_t p) { return p * n + 4 * p - p * p / 2; }  // sum of 8 (n - g), g < p
 size_t packedCount(size_t n) { return groupOffset(n, n); }
+// Where entry (p, s), p <= s, of the upper triangle sits.
+size_t packedAt(size_t n, size_t p, size_t s) {
+  const size_t first = p / 8 * 8, column = s - first;
+  return groupOffset(n, first) + column / 8 * 64 + (p - first) * 8 + column % 8;
+}
 
 // W values of T in one vector (GCC's vector extension: each clone maps it onto its own registers).
 template <class T, int W>
@@ -76,7 +83,7 @@ QV_HOT void packedSymmetricProduct(const C* Q, size_t n, const double* x, double
       // Row by row, so that one converted coefficient vector is live at a time (all eight at once
       // left no register for the eighth dot product).
       for (size_t g = 0; g < G; ++g) {
-        widen(row + g * length + s, std::make_integer_sequence<int, W>(), c);
+        widen(row + s / G * G * G + g * G + s % G, std::make_integer_sequence<int, W>(), c);  // packedAt
         dot[g] += c * xs;
         half[g / 4] = g % 4 ? half[g / 4] + c * xp[g] : c * xp[g];
       }
@@ -167,8 +174,7 @@ void ReducedPolynomial::build(int r, const double* c, bool single, bool groups, 
       s = x;
     }
     if (s == p) value *= 0.5;  // the product visits the diagonal twice
-    const size_t first = p / kBlock * kBlock;  // the group's first pair, and its rows' first column
-    const size_t at = groupOffset(padded, first) + (p - first) * (padded - first) + (s - first);
+    const size_t at = packedAt(padded, p, s);
     if (single)
       static_cast<float*>(Q)[at] = static_cast<float>(value);
     else
