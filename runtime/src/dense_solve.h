@@ -9,20 +9,41 @@ namespace quiver::rt {
 
 // Factorises symmetric positive definite A = U^T U in place (row-major, n x n; only its upper
 // triangle is read and overwritten by U). Returns false, leaving A spoiled, when A is not positive
-// definite. Right-looking, row by row: the inner loops are axpys along a row, which vectorise
-// without reordering any sum (choleskyFactorLanes(), cholesky_lanes.h, does the same operations in
-// the same order for a group of matrices).
+// definite. Right-looking, row by row: each pivot row j is scaled, then subtracted from the rows
+// below it, as axpys along a row, which vectorise without reordering any sum
+// (choleskyFactorLanes(), cholesky_lanes.h, does the same operations in the same order for a group
+// of matrices). Pivots are taken four at a time: the panel's rows first, then every row below
+// takes the four pivots' updates in one sweep, each entry in pivot order (the same operations in
+// the same order as one sweep per pivot, with a quarter of the loads, stores and short loops).
 inline bool choleskyFactor(double* A, int n) {
-  for (int j = 0; j < n; ++j) {
-    double* rowJ = A + j * n;
-    if (!(rowJ[j] > 0)) return false;
-    const double u = std::sqrt(rowJ[j]), inverse = 1 / u;
-    rowJ[j] = u;
-    for (int k = j + 1; k < n; ++k) rowJ[k] *= inverse;
-    for (int i = j + 1; i < n; ++i) {
+  constexpr int B = 4;
+  for (int j = 0; j < n; j += B) {
+    const int end = j + B < n ? j + B : n;
+    for (int t = j; t < end; ++t) {
+      double* rowT = A + t * n;
+      if (!(rowT[t] > 0)) return false;
+      const double u = std::sqrt(rowT[t]), inverse = 1 / u;
+      rowT[t] = u;
+      for (int k = t + 1; k < n; ++k) rowT[k] *= inverse;
+      for (int i = t + 1; i < end; ++i) {
+        double* rowI = A + i * n;
+        const double f = rowT[i];
+        for (int k = i; k < n; ++k) rowI[k] -= f * rowT[k];
+      }
+    }
+    if (end - j < B) break;  // the last panel: no rows below it
+    const double *r0 = A + j * n, *r1 = r0 + n, *r2 = r1 + n, *r3 = r2 + n;
+    for (int i = end; i < n; ++i) {
       double* rowI = A + i * n;
-      const double f = rowJ[i];
-      for (int k = i; k < n; ++k) rowI[k] -= f * rowJ[k];
+      const double f0 = r0[i], f1 = r1[i], f2 = r2[i], f3 = r3[i];
+      for (int k = i; k < n; ++k) {
+        double a = rowI[k];
+        a -= f0 * r0[k];
+        a -= f1 * r1[k];
+        a -= f2 * r2[k];
+        a -= f3 * r3[k];
+        rowI[k] = a;
+      }
     }
   }
   return true;
