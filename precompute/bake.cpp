@@ -133,7 +133,7 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   MeshSettings meshSettings = s.mesh;
   if (!isTetMeshPath(s.mesh.path)) meshSettings.path = meshSurface(ctx, s.mesh.path, s.surface, s.output.name);
   const MeshInputs in = stages.run("mesh", [&] { return loadMeshInputs(meshSettings); });
-  warnAboutMesh(ctx, in, meshSettings);
+  warnAboutMesh(ctx, in, s.mesh);  // names the file the user gave, not the tets meshed from it
   const RenderInputs render = bindRenderMesh(ctx, s.mesh.path, s.surface, in.mesh.mesh);
   // An eigensolver needs more DOFs than modes (k at the free DOFs leaves it no room to iterate).
   if (s.modes + (in.freeObject() ? 6 : 0) >= in.freeDofs || s.basis.settings.rank > in.freeDofs)

@@ -240,6 +240,13 @@ class Surface(unittest.TestCase):
         text = "".join("v {} {} {}\n".format(*c) for c in corners)
         return text, ["f " + " ".join(str(offset + k + 1) for k in q) for q in quads]
 
+    def test_a_surface_without_material_is_named(self):
+        # A surface carries no material: the warning names it, not the tets the bake meshed from it.
+        p = run(BAKE, self.obj, "--tets", 500, "--fix", "z<min+0.06", "--modes", 2, "--rank", 2, "--no-fidelity", "--quiet",
+                "-o", os.path.join(self.tmp.name, "unnamed_material"))
+        self.assertIn(f"{self.obj} defines no material; using E = ", p.stderr)
+        self.assertNotIn(".tets.vtu defines no material", p.stderr)
+
     def test_bad_surfaces_are_named(self):
         verts, faces = self.cube_obj()
         self.assertIn("open edges (holes)", self.bad("open.obj", verts + "\n".join(faces[:5]) + "\n", "--no-fill-holes"))
