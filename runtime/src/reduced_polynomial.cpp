@@ -35,8 +35,9 @@ double repeatFactor(const int (&idx)[N]) {
 // pairs padded to whole groups (n = blockedRows(P), zeros beyond P). The group's rows all start at
 // column p and run to n, and are interleaved eight columns at a time, [column / 8][row][column % 8],
 // so that a sweep over the group reads one sequential stream (eight streams, one per row, had cost
-// 10-15% at r = 30 and 40 with the coefficients in L3) and has no tail.
-size_t groupOffset(size_t n, size_t p) { return p * n + 4 * p - p * p / 2; }  // sum of 8 (n - g), g < p
+// 7-15% at r = 30 and 40 with the coefficients in L3) and has no tail.
+// Where the group of pair p (a multiple of 8) begins: 8 (n - g) summed over the groups g < p before it.
+size_t groupOffset(size_t n, size_t p) { return p * n + 4 * p - p * p / 2; }
 size_t packedCount(size_t n) { return groupOffset(n, n); }
 // Where entry (p, s), p <= s, of the upper triangle sits.
 size_t packedAt(size_t n, size_t p, size_t s) {
@@ -68,10 +69,11 @@ template <int W, class C>
 QV_HOT void packedSymmetricProduct(const C* Q, size_t n, const double* x, double* y) {
   using Vd = typename Vector<double, W>::type;
   constexpr size_t G = 8;
+  static_assert(G % W == 0, "a vector of columns stays within one interleaved run of eight");
   for (size_t s = 0; s < n; ++s) y[s] = 0;
   for (size_t p = 0; p < n; p += G) {
     const size_t length = n - p;
-    const C* row = Q + groupOffset(n, p);
+    const C* group = Q + groupOffset(n, p);
     Vd dot[G], xp[G];
     for (size_t g = 0; g < G; ++g) {
       dot[g] = Vd{};
@@ -83,7 +85,7 @@ QV_HOT void packedSymmetricProduct(const C* Q, size_t n, const double* x, double
       // Row by row, so that one converted coefficient vector is live at a time (all eight at once
       // left no register for the eighth dot product).
       for (size_t g = 0; g < G; ++g) {
-        widen(row + s / G * G * G + g * G + s % G, std::make_integer_sequence<int, W>(), c);  // packedAt
+        widen(group + s / G * G * G + g * G + s % G, std::make_integer_sequence<int, W>(), c);  // (p + g, p + s)
         dot[g] += c * xs;
         half[g / 4] = g % 4 ? half[g / 4] + c * xp[g] : c * xp[g];
       }
