@@ -36,13 +36,19 @@ double repeatFactor(const int (&idx)[N]) {
 // column p and run to n, and are interleaved eight columns at a time, [column / 8][row][column % 8],
 // so that a sweep over the group reads one sequential stream (eight streams, one per row, had cost
 // 7-15% at r = 30 and 40 with the coefficients in L3) and has no tail.
+constexpr size_t kGroup = ReducedPolynomial::kBlock;  // rows per group, and columns per interleaved run
+static_assert(kGroup == 8, "groupOffset() sums 8 (n - g)");
 // Where the group of pair p (a multiple of 8) begins: 8 (n - g) summed over the groups g < p before it.
 size_t groupOffset(size_t n, size_t p) { return p * n + 4 * p - p * p / 2; }
 size_t packedCount(size_t n) { return groupOffset(n, n); }
+// Where row `row` of a group holds its column `column`, both counted from the group's first pair.
+constexpr size_t inGroup(size_t row, size_t column) {
+  return column / kGroup * kGroup * kGroup + row * kGroup + column % kGroup;
+}
 // Where entry (p, s), p <= s, of the upper triangle sits.
 size_t packedAt(size_t n, size_t p, size_t s) {
-  const size_t first = p / 8 * 8, column = s - first;
-  return groupOffset(n, first) + column / 8 * 64 + (p - first) * 8 + column % 8;
+  const size_t first = p / kGroup * kGroup;
+  return groupOffset(n, first) + inGroup(p - first, s - first);
 }
 
 // W values of T in one vector (GCC's vector extension: each clone maps it onto its own registers).
@@ -68,8 +74,8 @@ template <class Vd, class C, int... I>
 template <int W, class C>
 QV_HOT void packedSymmetricProduct(const C* Q, size_t n, const double* x, double* y) {
   using Vd = typename Vector<double, W>::type;
-  constexpr size_t G = 8;
-  static_assert(G % W == 0, "a vector of columns stays within one interleaved run of eight");
+  constexpr size_t G = kGroup;
+  static_assert(G % W == 0, "a vector of columns stays within one interleaved run");
   for (size_t s = 0; s < n; ++s) y[s] = 0;
   for (size_t p = 0; p < n; p += G) {
     const size_t length = n - p;
@@ -85,7 +91,7 @@ QV_HOT void packedSymmetricProduct(const C* Q, size_t n, const double* x, double
       // Row by row, so that one converted coefficient vector is live at a time (all eight at once
       // left no register for the eighth dot product).
       for (size_t g = 0; g < G; ++g) {
-        widen(group + s / G * G * G + g * G + s % G, std::make_integer_sequence<int, W>(), c);  // (p + g, p + s)
+        widen(group + inGroup(g, s), std::make_integer_sequence<int, W>(), c);
         dot[g] += c * xs;
         half[g / 4] = g % 4 ? half[g / 4] + c * xp[g] : c * xp[g];
       }
