@@ -1,5 +1,7 @@
 #include "common/stvk_element.h"
 
+#include <vector>
+
 namespace quiver {
 
 Eigen::Matrix3d greenStrain(const Eigen::Matrix3d& H) { return 0.5 * (H + H.transpose() + H.transpose() * H); }
@@ -38,24 +40,64 @@ Matrix12 stvkElementTangent(const Eigen::Matrix3d& H, const Matrix34& G, double 
   return K;
 }
 
-RestDirection stvkRestDirection(const Matrix34& a, const Matrix34& G, double lambda, double mu) {
-  RestDirection d;
-  d.H = a * G.transpose();
-  d.dS = mu * (d.H + d.H.transpose()) + lambda * d.H.trace() * Eigen::Matrix3d::Identity();
-  return d;
+namespace {
+
+// \delta S along a direction whose displacement gradient is H.
+Eigen::Matrix3d deltaS(const Eigen::Matrix3d& H, double lambda, double mu) {
+  return mu * (H + H.transpose()) + lambda * H.trace() * Eigen::Matrix3d::Identity();
 }
 
-Matrix34 stvkElementForceHessianAtRest(const RestDirection& a, const RestDirection& b, const Matrix34& G, double V,
-                                       double lambda, double mu) {
-  const Eigen::Matrix3d HaHb = a.H.transpose() * b.H;
-  const Eigen::Matrix3d d2S = mu * (HaHb + HaHb.transpose()) + lambda * HaHb.trace() * Eigen::Matrix3d::Identity();
-  return V * (a.H * b.dS + b.H * a.dS + d2S) * G;
-}
+} // namespace
 
 Matrix34 stvkElementForceHessianAtRest(const Matrix34& a, const Matrix34& b, const Matrix34& G, double V,
                                        double lambda, double mu) {
-  return stvkElementForceHessianAtRest(stvkRestDirection(a, G, lambda, mu), stvkRestDirection(b, G, lambda, mu), G, V,
-                                       lambda, mu);
+  const Eigen::Matrix3d Ha = a * G.transpose(), Hb = b * G.transpose();
+  const Eigen::Matrix3d HaHb = Ha.transpose() * Hb;
+  const Eigen::Matrix3d d2S = mu * (HaHb + HaHb.transpose()) + lambda * HaHb.trace() * Eigen::Matrix3d::Identity();
+  return V * (Ha * deltaS(Hb, lambda, mu) + Hb * deltaS(Ha, lambda, mu) + d2S) * G;
+}
+
+void stvkElementForceHessiansAtRest(const Eigen::Matrix<double, 3, Eigen::Dynamic>& directions, const Matrix34& G,
+                                    double V, double lambda, double mu, double* out, Eigen::Index ld) {
+  const Eigen::Index k = directions.cols() / 4;
+  // Entry e (column-major) of direction j's H at h[e * k + j], of its \delta S at s[e * k + j].
+  std::vector<double> h(9 * k), s(9 * k);
+  for (Eigen::Index j = 0; j < k; ++j) {
+    const Eigen::Matrix3d H = directions.middleCols<4>(4 * j) * G.transpose();
+    const Eigen::Matrix3d dS = deltaS(H, lambda, mu);
+    for (int e = 0; e < 9; ++e) {
+      h[e * k + j] = H(e);
+      s[e * k + j] = dS(e);
+    }
+  }
+  for (Eigen::Index i = 0, p = 0; i < k; p += k - i, ++i) {
+    double ha[9], sa[9];
+    for (int e = 0; e < 9; ++e) {
+      ha[e] = h[e * k + i];
+      sa[e] = s[e * k + i];
+    }
+#pragma GCC ivdep
+    for (Eigen::Index j = i; j < k; ++j) {
+      double hb[9], sb[9];
+      for (int e = 0; e < 9; ++e) {
+        hb[e] = h[e * k + j];
+        sb[e] = s[e * k + j];
+      }
+      double hh[9];  // H_a^T H_b
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) hh[r + 3 * c] = ha[3 * r] * hb[3 * c] + ha[3 * r + 1] * hb[3 * c + 1] + ha[3 * r + 2] * hb[3 * c + 2];
+      const double trace = hh[0] + hh[4] + hh[8];
+      double m[9];  // V d^2P
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+          m[r + 3 * c] = V * ((ha[r] * sb[3 * c] + ha[r + 3] * sb[3 * c + 1] + ha[r + 6] * sb[3 * c + 2]) +
+                              (hb[r] * sa[3 * c] + hb[r + 3] * sa[3 * c + 1] + hb[r + 6] * sa[3 * c + 2]) +
+                              (mu * (hh[r + 3 * c] + hh[c + 3 * r]) + (r == c ? lambda * trace : 0.0)));
+      for (int v = 0; v < 4; ++v)
+        for (int r = 0; r < 3; ++r)
+          out[(3 * v + r) * ld + p + (j - i)] = m[r] * G(0, v) + m[r + 3] * G(1, v) + m[r + 6] * G(2, v);
+    }
+  }
 }
 
 } // namespace quiver

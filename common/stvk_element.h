@@ -41,13 +41,12 @@ Matrix12 stvkElementTangent(const Eigen::Matrix3d& H, const Matrix34& G, double 
 Matrix34 stvkElementForceHessianAtRest(const Matrix34& a, const Matrix34& b, const Matrix34& G, double V,
                                        double lambda, double mu);
 
-// The same from each direction's H and \delta S, which a caller pairing many directions on one
-// tet computes once per direction (modal derivatives' right-hand sides).
-struct RestDirection {
-  Eigen::Matrix3d H, dS;
-};
-RestDirection stvkRestDirection(const Matrix34& a, const Matrix34& G, double lambda, double mu);
-Matrix34 stvkElementForceHessianAtRest(const RestDirection& a, const RestDirection& b, const Matrix34& G, double V,
-                                       double lambda, double mu);
+// The same for every pair i <= j of k directions on one tet (modal derivatives' right-hand sides
+// need all k(k+1)/2): each direction's H and \delta S once, then the pairs with one i side by side,
+// so the sums vectorise across j. Direction i is columns 4i..4i+3 of `directions`. Pair (i, j)'s
+// d^2 f is column p of the row-major 12 x k(k+1)/2 block at `out` (row 3c + i: vertex c, component
+// i; rows `ld` apart), pairs in the order (0,0), (0,1), ..., (0,k-1), (1,1), ..., (k-1,k-1).
+void stvkElementForceHessiansAtRest(const Eigen::Matrix<double, 3, Eigen::Dynamic>& directions, const Matrix34& G,
+                                    double V, double lambda, double mu, double* out, Eigen::Index ld);
 
 } // namespace quiver

@@ -16,37 +16,31 @@ namespace quiver {
 
 namespace {
 
-// -d^2R[phi_i, phi_j] for every pair: this rank's rows (free DOFs x pairs). Each rank integrates
-// every tet touching its rows, in tet order (DofLayout::ownsRowOf: the same bits on every rank count
-// and every run; the tets on the partition's interface are integrated on each rank they touch), and
-// adds its own rows in place, each DOF's pairs side by side (a tet adds 12 contiguous rows, not
-// 12 x pairs scattered values).
+// -d^2R[phi_i, phi_j] for every pair i <= j, in the order of ModalDerivatives::pairs: this rank's
+// rows (free DOFs x pairs). Each rank integrates every tet touching its rows, in tet order
+// (DofLayout::ownsRowOf: the same bits on every rank count and every run; the tets on the
+// partition's interface are integrated on each rank they touch), and adds its own rows in place,
+// each DOF's pairs side by side (a tet adds 12 contiguous rows, not 12 x pairs scattered values).
 Eigen::MatrixXd rightHandSides(const TetMesh& mesh, const std::vector<Material>& perTet, const DofLayout& layout,
-                               const Eigen::MatrixXd& fullModes, const std::vector<std::array<int, 2>>& pairs) {
+                               const Eigen::MatrixXd& fullModes) {
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  const Eigen::Index P = static_cast<Eigen::Index>(pairs.size());
+  const RowMajor modes = fullModes;  // a vertex's 3 rows of every mode contiguous
+  const Eigen::Index k = modes.cols(), P = k * (k + 1) / 2;
   RowMajor own = RowMajor::Zero(layout.localDofs(), P);
   const TetElements elements = computeTetElements(mesh);
-  std::vector<RestDirection> modeOnTet(fullModes.cols());
+  Eigen::Matrix<double, 3, Eigen::Dynamic> modesOnTet(3, 4 * k);
   RowMajor values(12, P);
   for (int t = 0; t < mesh.tetCount(); ++t) {
     const Tet& tet = mesh.tets[t];
     if (!layout.ownsRowOf(tet)) continue;
-    const Material& m = perTet[t];
-    for (int i = 0; i < fullModes.cols(); ++i) {  // each mode's H and delta S once per tet, not per pair
-      Matrix34 onTet;
-      for (int a = 0; a < 4; ++a) onTet.col(a) = fullModes.block<3, 1>(3 * tet[a], i);
-      modeOnTet[i] = stvkRestDirection(onTet, elements.gradients[t], m.lambda(), m.mu());
-    }
-    for (Eigen::Index p = 0; p < P; ++p) {
-      const Matrix34 f = stvkElementForceHessianAtRest(modeOnTet[pairs[p][0]], modeOnTet[pairs[p][1]],
-                                                       elements.gradients[t], elements.volume[t], m.lambda(), m.mu());
-      values.col(p) = -Eigen::Map<const Eigen::Matrix<double, 12, 1>>(f.data());
-    }
+    for (Eigen::Index i = 0; i < k; ++i)
+      for (int a = 0; a < 4; ++a) modesOnTet.col(4 * i + a) = modes.block<3, 1>(3 * tet[a], i);
+    stvkElementForceHessiansAtRest(modesOnTet, elements.gradients[t], elements.volume[t], perTet[t].lambda(),
+                                   perTet[t].mu(), values.data(), P);
     for (int a = 0; a < 4; ++a)
       for (int c = 0; c < 3; ++c) {
         const int64_t dof = layout.dof(tet[a], c);
-        if (layout.owns(dof)) own.row(dof - layout.rowStart()) += values.row(3 * a + c);
+        if (layout.owns(dof)) own.row(dof - layout.rowStart()) -= values.row(3 * a + c);
       }
   }
   return own;
@@ -88,7 +82,7 @@ ModalDerivatives computeModalDerivatives(const TetMesh& mesh, const std::vector<
     for (int j = i; j < k; ++j) out.pairs.push_back({i, j});
 
   // Right-hand sides; projected below on free objects.
-  Eigen::MatrixXd b = rightHandSides(mesh, perTet, layout, layout.gatherToAll(modes.vectors), out.pairs);
+  Eigen::MatrixXd b = rightHandSides(mesh, perTet, layout, layout.gatherToAll(modes.vectors));
   Eigen::MatrixXd solveFor;                    // what the (possibly pinned) system is solved for
   const bool freeObject = rigid.cols() > 0;
   PetscMat pinned;

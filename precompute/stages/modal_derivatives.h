@@ -1,7 +1,7 @@
 #pragma once
 // Stage "derivatives": modal derivatives K Psi_ij = -d^2R[phi_i, phi_j] for i <= j <= k (Barbič &
 // James 2005), the second derivative of the internal force at rest applied to two modes. Each rank
-// computes the right-hand sides of its rows exactly (stvkElementForceHessianAtRest); all k(k+1)/2
+// computes the right-hand sides of its rows exactly (stvkElementForceHessiansAtRest); all k(k+1)/2
 // are solved in blocks with one Cholesky factorization of K (DirectSolver: the same bits every run),
 // the modes' own when they were computed at shift 0 in the same run.
 // On a free object K is singular: the right-hand sides are projected off the rigid modes, six
