@@ -928,6 +928,7 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     RigidFrame& f = bodies[i].instance->frame;
     std::memcpy(f.velocity, bodies[i].velocity, sizeof f.velocity);
     std::memcpy(f.angularMomentum, bodies[i].angularMomentum, sizeof f.angularMomentum);
+    if (bodies[i].modesPredicted) bodies[i].instance->softContact = true;
   }
   // The same impulses over the step load the deformations where they act, less the bounce: the
   // restitution already returns that energy to the frames, and loading q with it too would make energy.

@@ -208,6 +208,7 @@ void qv_instance::setGravity(const double g[3]) {
 
 void qv_instance::beginStep() {
   lastStep = qv_step_report{};
+  softContact = false;
   if (!flying()) return;
   const double h = config.time_step;
   frame.refresh(*model, q, v);

@@ -110,6 +110,8 @@ struct qv_instance {
   // and the impulses since.
   double* modeCompliance = nullptr;
   double* modeVelocity = nullptr;
+  // This step's contact solve let its deformation give way (soft contacts touching it).
+  bool softContact = false;
 
   void carve(quiver::rt::BlockCarver& c);
   void rest();

@@ -17,13 +17,15 @@ struct Dropped {
   double h;
   Dropped(double step, std::vector<qv_collider> world, const qv_rigid_state& start, double alpha = 5,
           std::array<int, 3> cells = {6, 1, 1}, Eigen::Vector3d size = {0.6, 0.1, 0.1}, bool softContacts = false,
-          qv_integrator integrator = QV_INTEGRATOR_IMPLICIT_NEWMARK, qv_solver solver = QV_SOLVER_MINIMIZE)
+          qv_integrator integrator = QV_INTEGRATOR_IMPLICIT_NEWMARK, qv_solver solver = QV_SOLVER_MINIMIZE,
+          int newtonIterations = 0)
       : bar(16, cells, size), colliders(world), h(step) {
     qv_instance_config c = bar.config(h);
     c.rayleigh_alpha = alpha;
     c.soft_contacts = softContacts ? 1 : 0;
     c.integrator = integrator;
     c.solver = solver;
+    if (newtonIterations > 0) c.newton_iterations = newtonIterations;
     inst = std::make_unique<test::Instance>(bar.model, c);
     EXPECT_EQ(qv_instance_set_rigid_state(inst->s, &start), QV_OK);
     const double g[3] = {0, 0, -QV_STANDARD_GRAVITY};
