@@ -111,21 +111,24 @@ QV_HOT double* evaluateTogether(qv_instance* const* members, int count, double* 
 }
 
 // Fixed Newton steps, up to kLanes: one evaluation each, at the first guess, and its Newton
-// matrix, both together.
+// matrix, both together. Members whose contact solve touched soft contacts take the minimiser's
+// step instead (implicit_newmark.cpp): not evaluated here.
 void stepNewtonGroup(qv_instance* const* group, const int* index, int count, double* scratch,
                      qv_step_status* statuses) {
+  qv_instance* fixed[kLanes];
+  SystemScales scales[kLanes];
+  int fixedCount = 0;
   for (int l = 0; l < count; ++l) {
     qv_instance& s = *group[l];
     s.beginOwnStep();
+    if (s.softContact) continue;
     for (int i = 0; i < s.r; ++i) s.work.presetAt[i] = newmarkGuess(s, i);
-  }
-  SystemScales scales[kLanes];
-  for (int l = 0; l < count; ++l) {
     double c1, c2;
-    newmarkNewtonScales(*group[l], c1, c2);
-    scales[l] = newtonSystem(*group[l], c1, c2);
+    newmarkNewtonScales(s, c1, c2);
+    scales[fixedCount] = newtonSystem(s, c1, c2);
+    fixed[fixedCount++] = &s;
   }
-  factoriseGroup(group, count, scales, evaluateTogether(group, count, scratch));
+  if (fixedCount > 0) factoriseGroup(fixed, fixedCount, scales, evaluateTogether(fixed, fixedCount, scratch));
   for (int l = 0; l < count; ++l) {
     const qv_step_status status = group[l]->finishStep();
     if (statuses) statuses[index[l]] = status;

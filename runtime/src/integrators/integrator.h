@@ -58,6 +58,9 @@ inline void newmarkNewtonScales(const qv_instance& s, double& c1, double& c2) {
 inline qv_step_status minimizedInstead(qv_instance& s, StepFunction minimizing) {
   s.lastStep = qv_step_report{};
   s.lastStep.minimized = 1;
+  // A group's preset evaluation is not whole once D below overwrites its stiffness.
+  s.work.presetValid = false;
+  s.work.presetFactor = LaneFactor{};
   // Its energy budget and damping start from this state, as after qv_instance_set_state: fixed
   // Newton steps keep no account of E(q) and D.
   s.elasticEnergyAtState = elasticEnergy(*s.model, s.config.elasticity, s.q, s.work.polynomialScratch);
