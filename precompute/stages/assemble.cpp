@@ -46,11 +46,15 @@ struct RowPattern {
   }
 };
 
+// AIJ: sequential on one rank, as MatCreateAIJ makes it (MatCreateMPIAIJWithArrays would not).
 PetscMat createMatrix(const DofLayout& layout, const RowPattern& pattern, const std::vector<double>& values) {
   PetscMat A;
-  QV_PETSC(MatCreateMPIAIJWithArrays(layout.comm(), layout.localDofs(), layout.localDofs(), layout.globalDofs(),
-                                     layout.globalDofs(), pattern.rowStart.data(), pattern.columns.data(),
-                                     values.data(), A.out()));
+  QV_PETSC(MatCreate(layout.comm(), A.out()));
+  QV_PETSC(MatSetSizes(A, layout.localDofs(), layout.localDofs(), layout.globalDofs(), layout.globalDofs()));
+  QV_PETSC(MatSetType(A, MATAIJ));
+  // Each copies the arrays and assembles; the one not of A's type does nothing.
+  QV_PETSC(MatSeqAIJSetPreallocationCSR(A, pattern.rowStart.data(), pattern.columns.data(), values.data()));
+  QV_PETSC(MatMPIAIJSetPreallocationCSR(A, pattern.rowStart.data(), pattern.columns.data(), values.data()));
   QV_PETSC(MatSetOption(A, MAT_SYMMETRIC, PETSC_TRUE));
   QV_PETSC(MatSetOption(A, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
   return A;
