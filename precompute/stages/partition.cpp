@@ -28,9 +28,12 @@ void dualGraph(const TetMesh& mesh, std::vector<idx_t>& xadj, std::vector<idx_t>
       faces.push_back({f, t});
     }
   std::sort(faces.begin(), faces.end());
-  std::vector<std::array<int, 2>> edges;
-  for (size_t i = 0; i + 1 < faces.size(); ++i)
-    if (faces[i].first == faces[i + 1].first) edges.push_back({faces[i].second, faces[i + 1].second});
+  std::vector<std::array<int, 2>> edges;  // every pair of tets on a face (more than two where it is not manifold)
+  for (size_t first = 0, end = 0; first < faces.size(); first = end) {
+    while (end < faces.size() && faces[end].first == faces[first].first) ++end;
+    for (size_t a = first; a < end; ++a)
+      for (size_t b = a + 1; b < end; ++b) edges.push_back({faces[a].second, faces[b].second});
+  }
   xadj.assign(mesh.tetCount() + 1, 0);
   for (const auto& e : edges) ++xadj[e[0] + 1], ++xadj[e[1] + 1];
   for (int t = 0; t < mesh.tetCount(); ++t) xadj[t + 1] += xadj[t];
