@@ -110,7 +110,7 @@ struct qv_instance {
   // and the impulses since.
   double* modeCompliance = nullptr;
   double* modeVelocity = nullptr;
-  // This step's contact solve let its deformation give way (soft contacts touching it).
+  // This step's contact solve let its deformation give way (soft contacts touching it, or within reach).
   bool softContact = false;
 
   void carve(quiver::rt::BlockCarver& c);

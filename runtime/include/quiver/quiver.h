@@ -163,7 +163,7 @@ typedef enum qv_solver {
                              moderate. Where they do not (stiff springs, large twists, long time steps, sudden loads
                              and releases), the iterations add energy and can diverge: a step whose system is not
                              positive definite, or whose end may move a vertex farther than max_displacement (or,
-                             under implicit Newmark, which soft contacts touch: qv_instance_config.soft_contacts), is
+                             under implicit Newmark, with soft contacts in its solve: qv_instance_config.soft_contacts), is
                              taken by the minimising solver instead (at most 8 iterations; qv_step_report.minimized),
                              so it does not reset on finite input either; the energy the fixed steps add stays, and
                              within max_displacement nothing bounds it (a 3 m bar of 1 MPa lying bent on the ground,
@@ -206,10 +206,11 @@ typedef struct qv_instance_config {
                                 lets the deformation give way where it pushes (a soft object rests flat instead of sagging
                                 through what holds it: docs/architecture.md, Contact); 0 (default): they hold the rigid
                                 shape the frame carries, and the deformation only takes their forces. Under implicit
-                                Newmark with QV_SOLVER_NEWTON, a step these contacts touch is the minimiser's
-                                (qv_step_report.minimized): the trapezoidal rule's fixed steps rang against them (a 3 m
-                                soft bar resting on the ground: vertices at 5-9 cm/s after 20 s) and, at one Newton
-                                iteration, threw the bar off. Backward Euler's fixed steps rest there */
+                                Newmark with QV_SOLVER_NEWTON, a step with such contacts in its solve (touching, or
+                                within reach) is the minimiser's (qv_step_report.minimized): the trapezoidal rule's
+                                fixed steps rang against them (a 3 m soft bar resting on the ground: vertices at
+                                5-9 cm/s after 20 s) and, at one or two Newton iterations, threw the bar off. Backward
+                                Euler's fixed steps rest there */
 } qv_instance_config;
 
 /* Defaults for `model` (pass NULL for model-independent defaults). */
@@ -249,7 +250,7 @@ typedef struct qv_step_report {
   double energy_removed;   /* QV_SOLVER_MINIMIZE: kinetic energy (J) the step took out so as not to add energy */
   int minimized;           /* QV_SOLVER_NEWTON: 1 when the minimising solver took the step (the Newton system was not
                               positive definite, the step may have moved a vertex past max_displacement, or, under
-                              implicit Newmark, soft contacts touched it); the fields above then describe its step */
+                              implicit Newmark, soft contacts were in its solve); the fields above then describe its step */
 } qv_step_report;
 QV_API void qv_instance_last_step(const qv_instance* instance, qv_step_report* report);
 
