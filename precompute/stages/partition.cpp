@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <array>
-#include <utility>
 #include <stdexcept>
 #include <string>
 
 #include <metis.h>
 
+#include "common/surface.h"
 #include "precompute/checkpoint.h"
 
 namespace quiver {
@@ -17,22 +17,13 @@ namespace {
 // The dual graph in METIS's CSR form: tets that share a face, found by sorting the faces
 // (METIS_MeshToDual counts shared vertices instead, 0.25 s of a 97k-tet bake).
 void dualGraph(const TetMesh& mesh, std::vector<idx_t>& xadj, std::vector<idx_t>& adjncy) {
-  std::vector<std::pair<std::array<int, 3>, int>> faces;
-  faces.reserve(4 * static_cast<size_t>(mesh.tetCount()));
-  for (int t = 0; t < mesh.tetCount(); ++t)
-    for (int omit = 0; omit < 4; ++omit) {
-      std::array<int, 3> f;
-      for (int k = 0, n = 0; k < 4; ++k)
-        if (k != omit) f[n++] = mesh.tets[t][k];
-      std::sort(f.begin(), f.end());
-      faces.push_back({f, t});
-    }
-  std::sort(faces.begin(), faces.end());
+  const auto faces = sortedFaces(mesh);
   std::vector<std::array<int, 2>> edges;  // every pair of tets on a face (more than two where it is not manifold)
   for (size_t first = 0, end = 0; first < faces.size(); first = end) {
     while (end < faces.size() && faces[end].first == faces[first].first) ++end;
     for (size_t a = first; a < end; ++a)
-      for (size_t b = a + 1; b < end; ++b) edges.push_back({faces[a].second, faces[b].second});
+      for (size_t b = a + 1; b < end; ++b)
+        edges.push_back({static_cast<int>(faces[a].second / 4), static_cast<int>(faces[b].second / 4)});
   }
   xadj.assign(mesh.tetCount() + 1, 0);
   for (const auto& e : edges) ++xadj[e[0] + 1], ++xadj[e[1] + 1];
