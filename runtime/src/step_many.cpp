@@ -111,8 +111,8 @@ QV_HOT double* evaluateTogether(qv_instance* const* members, int count, double* 
 }
 
 // Fixed Newton steps, up to kLanes: one evaluation each, at the first guess, and its Newton
-// matrix, both together. Members whose contact solve touched soft contacts take the minimiser's
-// step instead (implicit_newmark.cpp): not evaluated here.
+// matrix, both together. Members whose step is the minimiser's (newmarkStepMinimized()) are not
+// evaluated here.
 void stepNewtonGroup(qv_instance* const* group, const int* index, int count, double* scratch,
                      qv_step_status* statuses) {
   qv_instance* fixed[kLanes];
@@ -121,7 +121,7 @@ void stepNewtonGroup(qv_instance* const* group, const int* index, int count, dou
   for (int l = 0; l < count; ++l) {
     qv_instance& s = *group[l];
     s.beginOwnStep();
-    if (s.softContact) continue;
+    if (newmarkStepMinimized(s)) continue;
     for (int i = 0; i < s.r; ++i) s.work.presetAt[i] = newmarkGuess(s, i);
     double c1, c2;
     newmarkNewtonScales(s, c1, c2);

@@ -1,7 +1,7 @@
 // Contact of a flying bar with colliders, against mechanics worked by hand: at rest on a plane the
 // contacts carry exactly its weight; sliding stops after v0 / (mu g); a bounce never gains energy;
 // the colliders' signed distances against geometry; bad colliders refused; with soft contacts, a
-// soft bar lies straight on the ground (with either solver under backward Euler).
+// soft bar lies straight on the ground (with either solver and either implicit integrator).
 #include <gtest/gtest.h>
 
 #include <cmath>

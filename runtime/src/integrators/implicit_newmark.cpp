@@ -44,7 +44,7 @@ qv_step_status stepImplicitNewmark(qv_instance& s) {
   // Soft contacts pin the deformation where they hold it, and the trapezoidal rule then flips its
   // velocity there every step (v' = 2 (q' - q) / h - v): fixed steps rang against a resting bar and,
   // at one or two iterations, fed it until it flew off. The minimiser's energy budget bounds them.
-  if (s.softContact) return minimizedInstead(s, minimizing);
+  if (newmarkStepMinimized(s)) return minimizedInstead(s, minimizing);
   const double h = s.config.time_step, beta = kNewmarkBeta, gamma = kNewmarkGamma;
   const int r = s.r;
   const double *q = s.q, *v = s.v, *a = s.a;

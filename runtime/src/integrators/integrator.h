@@ -40,6 +40,10 @@ inline double newmarkGuess(const qv_instance& s, int i) {
   const double h = s.config.time_step;
   return s.q[i] + h * s.v[i] + 0.5 * h * h * s.a[i];
 }
+// Whether implicit Newmark's fixed Newton step is the minimiser's from its start: soft contacts were
+// in its solve (implicit_newmark.cpp says why). A group (step_many.cpp) leaves such a step out of
+// its evaluation.
+inline bool newmarkStepMinimized(const qv_instance& s) { return s.softContact; }
 // Implicit Newmark's parameters (the trapezoidal rule), and the scales of its fixed Newton step's
 // system (I + c1 C + c2 (K + J)) x = rhs.
 constexpr double kNewmarkBeta = 0.25, kNewmarkGamma = 0.5;
