@@ -303,6 +303,7 @@ struct FlyingCrowd {
   std::vector<int> batchedMinimized = std::vector<int>(kCount), singleMinimized = std::vector<int>(kCount);
   qv_collider ground = quiver::test::makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0.2);  // the instances keep a pointer
 
+  FlyingCrowd(const FlyingCrowd&) = delete;  // its instances point at its `ground`
   FlyingCrowd(const qv_model* model, const qv_instance_config& config) {
     const double g[3] = {0, 0, -9.81};
     for (int i = 0; i < 2 * kCount; ++i) {
