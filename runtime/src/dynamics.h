@@ -47,7 +47,7 @@ LaneFactor takePresetFactor(qv_instance& s, const SystemScales& scales);
 
 // Solves the Newton system for the right-hand side in s.work.correction (the correction replaces
 // it) by Cholesky; false when large compression has made the matrix indefinite (the step is then
-// the minimiser's: integrator.h, minimizedInstead()).
+// the minimiser's: fixed_newton.h, minimizedInstead()).
 bool solveNewton(qv_instance& s, const double* stateJacobian, double c1, double c2);
 
 } // namespace quiver::rt

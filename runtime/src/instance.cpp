@@ -152,6 +152,7 @@ void qv_instance::rest() {
   std::memset(a, 0, sizeof(double) * r);
   elasticEnergyAtState = 0;
   energySlack = 0;
+  elasticAllowance = 0;
   quiver::rt::dampWithStiffness(*this, model->restStiffness, dampingStiffness);
   contacts.clear();
   if (flying()) frame.goHome();
@@ -289,10 +290,10 @@ void qv_instance::setState(const double* newQ, const double* newV, const double*
   if (newV) std::memcpy(v, newV, sizeof(double) * r);
   const bool consistentA = !newA && (newQ || newV);
   if (newQ || consistentA) quiver::rt::evaluateForces(*this, q);  // R(q) + S(q), K(q)
-  if (newQ) {
+  // Fixed Newton steps keep E(q) only in their account, which a new velocity starts anew too.
+  if (newQ || !minimizes())
     elasticEnergyAtState = quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
-    quiver::rt::dampWithStiffness(*this, work.stiffness, dampingStiffness);
-  }
+  if (newQ) quiver::rt::dampWithStiffness(*this, work.stiffness, dampingStiffness);
   if (newA) {
     std::memcpy(a, newA, sizeof(double) * r);
   } else if (consistentA) {
@@ -303,6 +304,7 @@ void qv_instance::setState(const double* newQ, const double* newV, const double*
     for (int i = 0; i < r; ++i) a[i] = loads.gravityForce[i] - work.force[i] - work.damping[i];
   }
   energySlack = 0;
+  elasticAllowance = elasticEnergyAtState;
 }
 
 void qv_instance::dampingStiffnessAtState(double* D) const {
@@ -315,11 +317,13 @@ void qv_instance::saveSnapshot(double* out) const {
   std::memcpy(out + 1, q, sizeof(double) * r);
   std::memcpy(out + 1 + r, v, sizeof(double) * r);
   std::memcpy(out + 1 + 2 * r, a, sizeof(double) * r);
-  // The minimiser's energy budget; other solvers keep no account of E(q), so theirs is written as a
-  // minimising instance restored from it must start (a new budget from this state).
+  // The minimiser's energy budget. Fixed Newton steps leave E(q) to their next step: it is
+  // evaluated here, and their account written as the slack it leaves (negative: an excess), which a
+  // minimising instance restored from it owes too; their own takes the allowance at the end.
   const bool budgeted = minimizes();
-  out[1 + 3 * r] = budgeted ? elasticEnergyAtState : quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
-  out[2 + 3 * r] = budgeted ? energySlack : 0.0;
+  const double elastic = budgeted ? elasticEnergyAtState : quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
+  out[1 + 3 * r] = elastic;
+  out[2 + 3 * r] = budgeted ? energySlack : elasticAllowance - elastic;
   double* f = out + 3 + 3 * r;
   if (flying()) {
     std::memcpy(f, frame.position, 3 * sizeof(double));
@@ -342,10 +346,14 @@ void qv_instance::saveSnapshot(double* out) const {
   // What the next step compares its loads with (Loads::changedSinceLastStep()).
   std::memcpy(f, loads.lastStepForce, sizeof(double) * r);
   f[r] = loads.changed ? 1.0 : 0.0;
+  f[r + 1] = budgeted ? elasticEnergyAtState + energySlack : elasticAllowance;
 }
 
 bool qv_instance::restoreSnapshot(const double* in) {
   if (in[0] != r) return false;
+  // A state, a budget or a frame that is not finite would only be reset by the next step.
+  for (size_t i = 1; i < snapshotSize() / sizeof(double); ++i)
+    if (!std::isfinite(in[i])) return false;
   // D must be positive definite, or the damping would add energy: checked before anything changes.
   const double* savedD = in + 3 + 3 * r + (flying() ? 16 : 0);
   for (int i = 0, k = 0; i < r; ++i)
@@ -361,6 +369,7 @@ bool qv_instance::restoreSnapshot(const double* in) {
   std::memcpy(a, in + 1 + 2 * r, sizeof(double) * r);
   elasticEnergyAtState = in[1 + 3 * r];
   energySlack = in[2 + 3 * r];
+  elasticAllowance = savedLoads[r + 1];
   contacts.clear();  // the snapshot does not carry them: the next step's contacts start cold
   if (flying()) {
     const double* f = in + 3 + 3 * r;

@@ -77,8 +77,12 @@ struct qv_instance {
   int r;
   double maxQ;  // |q|_inf past which a step has blown up (a fixed Newton step's end, central differences)
   double *q, *v, *a;
-  double elasticEnergyAtState;  // E(q) for the minimising solver's energy budget (fixed Newton steps leave it stale)
+  double elasticEnergyAtState;  // E(q) for the energy budget (a fixed Newton step's end leaves it stale)
   double energySlack;           // energy the discretisation lost that a later step may win back
+  // QV_SOLVER_NEWTON's energy account (integrators/fixed_newton.h): the most E(q) the state may hold
+  // within the last step's budget, which the next fixed step's start settles (E(q) plus the slack
+  // where no fixed step left it: a new state, a step the minimiser took).
+  double elasticAllowance;
   // D, r x r: the minimising solver's Rayleigh damping C = alpha I + beta D through a step. K(q) at
   // the step's start, shifted to positive definite where compression made it indefinite
   // (dampWithStiffness(), dynamics.h).
@@ -146,11 +150,11 @@ struct qv_instance {
   qv_step_status endStep(qv_step_status status);  // the per-step loads are spent; a blown-up state resets
   // The snapshot: r, then q, v, a, E(q) and the energy slack, then in flight the frame (position,
   // orientation, velocity, angular momentum, last body omega), then D's upper triangle row by row,
-  // then the last step's per-step forces and whether a persistent load changed since (1 or 0), as
-  // doubles: all a step reads beyond the caller's calls.
+  // then the last step's per-step forces and whether a persistent load changed since (1 or 0), then
+  // the elastic allowance, as doubles: all a step reads beyond the caller's calls.
   size_t snapshotSize() const {
     const size_t n = static_cast<size_t>(r);
-    return sizeof(double) * (3 * n + 3 + (flying() ? 16 : 0) + n * (n + 1) / 2 + n + 1);
+    return sizeof(double) * (3 * n + 3 + (flying() ? 16 : 0) + n * (n + 1) / 2 + n + 2);
   }
   void saveSnapshot(double* out) const;
   bool restoreSnapshot(const double* in);

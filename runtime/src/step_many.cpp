@@ -16,8 +16,9 @@ constexpr int kLanes = ReducedPolynomial::kLanes;
 
 size_t pairs(int r) { return static_cast<size_t>(r) * (r + 1) / 2; }
 
-// Whose step begins with a polynomial evaluation at newmarkGuess() (both Newmark solvers' does),
-// on a model laid out for groups (qv_model_config.group_layout).
+// Whose step begins with a polynomial evaluation (implicit Newmark's: the minimiser's at
+// newmarkGuess(), the fixed Newton step's at q), on a model laid out for groups
+// (qv_model_config.group_layout).
 bool groupable(const qv_instance& s) {
   return s.config.integrator == QV_INTEGRATOR_IMPLICIT_NEWMARK && s.config.elasticity == QV_ELASTICITY_STVK &&
          s.model->polynomial.groups();
@@ -110,8 +111,8 @@ QV_HOT double* evaluateTogether(qv_instance* const* members, int count, double* 
   return stiffnessLanes;
 }
 
-// Fixed Newton steps, up to kLanes: one evaluation each, at the first guess, and its Newton
-// matrix, both together. Members whose step is the minimiser's (newmarkStepMinimized()) are not
+// Fixed Newton steps, up to kLanes: one evaluation each, at the state (fixed_newton.h), and its
+// Newton matrix, both together. Members whose step is the minimiser's (newmarkStepMinimized()) are not
 // evaluated here.
 void stepNewtonGroup(qv_instance* const* group, const int* index, int count, double* scratch,
                      qv_step_status* statuses) {
@@ -122,7 +123,7 @@ void stepNewtonGroup(qv_instance* const* group, const int* index, int count, dou
     qv_instance& s = *group[l];
     s.beginOwnStep();
     if (newmarkStepMinimized(s)) continue;
-    for (int i = 0; i < s.r; ++i) s.work.presetAt[i] = newmarkGuess(s, i);
+    std::memcpy(s.work.presetAt, s.q, sizeof(double) * s.r);
     double c1, c2;
     newmarkNewtonScales(s, c1, c2);
     scales[fixedCount] = newtonSystem(s, c1, c2);

@@ -374,11 +374,11 @@ TEST(StepMany, FlyingInstancesOnTheirCollidersAgreeWithSteppingOneByOne) {
 
 // Fixed Newton steps that soft contacts touch are the minimiser's (implicit_newmark.cpp) in a
 // group as alone; the group leaves those members out of its evaluation. Soft contacts make the
-// crowd far more sensitive than above: 1e-13 more spin on each bar moved them 1.4e-6 m apart by
-// the end (1.3e-12 m without soft contacts), and the group's evaluations in flight differ from one
-// state's in the last bits: measured 2.5e-7 m apart. Had a group stepped on with fixed Newton steps,
-// its bars would ring (q to 1.4e-2 against 4e-4); had its minimiser started from the group's
-// evaluation with the state's stiffness, they would end 7.6e-5 m apart.
+// crowd far more sensitive than above: the group's evaluations in flight differ from one state's
+// in the last bits, and so does 1e-13 more spin on each bar, which moves them 3e-9 m apart in the
+// first 0.5 s (the landings) and 7e-5 m by 1.5 s, when one bar settles otherwise. So the twins are
+// compared after the landings: measured 7e-11 m apart. Had a group stepped on with fixed Newton
+// steps, its bars would ring (q to 1.4e-2 against 4e-4 after 1.5 s).
 TEST(StepMany, FixedNewtonStepsSoftContactsTouchAreTheMinimisersInAGroupToo) {
   quiver::test::FreeBar bar;
   ASSERT_NE(bar.model, nullptr);
@@ -386,18 +386,24 @@ TEST(StepMany, FixedNewtonStepsSoftContactsTouchAreTheMinimisersInAGroupToo) {
   config.solver = QV_SOLVER_NEWTON;
   config.soft_contacts = 1;
   FlyingCrowd crowd(bar.model, config);
-  crowd.run(bar.model, 180);
+  crowd.run(bar.model, 60);
   for (int i = 0; i < FlyingCrowd::kCount; ++i) {
-    EXPECT_GT(crowd.singleMinimized[i], 20) << "bar " << i;
+    EXPECT_GT(crowd.singleMinimized[i], 10) << "bar " << i;
     EXPECT_NEAR(crowd.batchedMinimized[i], crowd.singleMinimized[i], 2) << "bar " << i;
   }
   double worstPosition = 0, worstQ = 0, largestQ = 0;
   crowd.differences(bar.info.r, worstPosition, worstQ, largestQ);
-  std::printf("soft contacts, fixed Newton: minimiser's steps %d of 180 (bar 0, one by one), %d in the group; centres within %.1e m, q within %.1e of its largest %.1e\n",
+  std::printf("soft contacts, fixed Newton: minimiser's steps %d of 60 (bar 0, one by one), %d in the group; centres within %.1e m, q within %.1e of its largest %.1e\n",
               crowd.singleMinimized[0], crowd.batchedMinimized[0], worstPosition, worstQ, largestQ);
-  EXPECT_LT(worstPosition, 1e-5);
-  EXPECT_LT(worstQ, 1e-2 * largestQ);
-  EXPECT_LT(largestQ, 2e-3);
+  EXPECT_LT(worstPosition, 1e-7);
+  EXPECT_LT(worstQ, 1e-6 * largestQ);
+  crowd.run(bar.model, 120);
+  for (const std::vector<qv_instance*>& twins : {crowd.batched, crowd.single})
+    for (qv_instance* s : twins) {
+      Eigen::VectorXd q(bar.info.r);
+      qv_instance_get_state(s, q.data(), nullptr, nullptr);
+      EXPECT_LT(q.lpNorm<Eigen::Infinity>(), 2e-3);
+    }
 }
 
 TEST(StepMany, JobsOnThreadsGiveTheSameStatesAsOneJob) {

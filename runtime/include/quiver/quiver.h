@@ -16,7 +16,7 @@ extern "C" {
 #endif
 
 #define QV_VERSION_MAJOR 0
-#define QV_VERSION_MINOR 11
+#define QV_VERSION_MINOR 12
 #define QV_VERSION_PATCH 0
 #define QV_VERSION_NUMBER (QV_VERSION_MAJOR * 10000 + QV_VERSION_MINOR * 100 + QV_VERSION_PATCH)
 
@@ -159,16 +159,19 @@ typedef enum qv_solver {
                              the Newton iterations do. Costs about 2x a fixed Newton step where one iteration
                              converges, 3x where two do (bench/README.md). */
   QV_SOLVER_NEWTON = 1,   /* Barbic & James 2005: exactly newton_iterations Newton iterations on the equations of
-                             motion, no line search, C = alpha I + beta K(q): the fastest while the strains stay
-                             moderate. Where they do not (stiff springs, large twists, long time steps, sudden loads
-                             and releases), the iterations add energy and can diverge: a step whose system is not
-                             positive definite, or whose end may move a vertex farther than max_displacement (or,
-                             under implicit Newmark, with soft contacts in its solve: qv_instance_config.soft_contacts), is
-                             taken by the minimising solver instead (at most 8 iterations; qv_step_report.minimized),
-                             so it does not reset on finite input either; the energy the fixed steps add stays, and
-                             within max_displacement nothing bounds it (a 3 m bar of 1 MPa lying bent on the ground,
-                             rigid contacts, one or two iterations: its deformation ran away and threw it off at
-                             50 m/s within 2 s; three held it). */
+                             motion, the first linearised at the step's start (as Vega's implicit Newmark), no line
+                             search, C = alpha I + beta K(q): the fastest while the strains stay moderate. The total
+                             energy is held to the same budget as the minimiser's, one step late: what a step ended
+                             with beyond it is taken out of the velocity at the next step's start (E at the end is
+                             evaluated there anyway); the position is not drawn back. Where strains are large (stiff
+                             springs, large twists, long time steps, sudden loads and releases) the iterations can
+                             diverge: a step whose system is not positive definite, or whose end may move a vertex
+                             farther than max_displacement (or, under implicit Newmark, with soft contacts in its
+                             solve: qv_instance_config.soft_contacts), is taken by the minimising solver instead (at
+                             most 8 iterations; qv_step_report.minimized), so it does not reset on finite input
+                             either. (Linearised at the guess the last acceleration gives instead, one or two
+                             iterations a step threw a 3 m bar of 1 MPa resting on rigid contacts off at thousands
+                             of m/s: runtime 0.11 and before.) */
   QV_SOLVER_COUNT
 } qv_solver;
 
@@ -247,7 +250,8 @@ typedef struct qv_step_report {
   double gradient;         /* QV_SOLVER_MINIMIZE: |gradient| / force scale at the end */
   int held_back;           /* QV_SOLVER_MINIMIZE: 1 when the end position alone held more energy than the step may
                               end with, so it was drawn back toward the start (the velocity keeps what is left) */
-  double energy_removed;   /* QV_SOLVER_MINIMIZE: kinetic energy (J) the step took out so as not to add energy */
+  double energy_removed;   /* kinetic energy (J) the step took out so as not to add energy (QV_SOLVER_NEWTON: at its
+                              start, what the step before ended with beyond its budget) */
   int minimized;           /* QV_SOLVER_NEWTON: 1 when the minimising solver took the step (the Newton system was not
                               positive definite, the step may have moved a vertex past max_displacement, or, under
                               implicit Newmark, soft contacts were in its solve); the fields above then describe its step */
@@ -260,7 +264,7 @@ QV_API void qv_instance_last_step(const qv_instance* instance, qv_step_report* r
    Newton matrices are factorised 8 at a time (not in free flight, where they depend on the state),
    on models loaded with the groups' layout (qv_model_config.group_layout; without it each
    instance steps as alone).
-   QV_SOLVER_NEWTON steps go in groups of 8 (the first guess's evaluation and matrix: the whole of
+   QV_SOLVER_NEWTON steps go in groups of 8 (the evaluation and matrix at the state: the whole of
    a one-iteration step but its substitution); QV_SOLVER_MINIMIZE steps run up to 8 in lock step,
    sharing every evaluation of their iterations and line searches (the energy budget's rare
    draw-back evaluates alone). The sums run in another
@@ -308,9 +312,9 @@ QV_API void qv_instance_set_state(qv_instance* instance, const double* q, const 
    stiffness, r (r + 1) / 2 values, and the last step's per-step forces, which the next step's
    budget compares with) as an opaque block of qv_instance_snapshot_size() bytes, for rewinding,
    replays and save games: restoring a snapshot and repeating the same calls repeats the same bits.
-   Restoring checks the size, that the snapshot came from a model of the same r and that its
-   damping stiffness is positive definite (QV_ERROR_INVALID_ARGUMENT otherwise, the instance
-   unchanged). Restoring also restores whether a persistent load had changed since that step, so
+   Restoring checks the size, that the snapshot came from a model of the same r, that its values
+   are finite and that its damping stiffness is positive definite (QV_ERROR_INVALID_ARGUMENT
+   otherwise, the instance unchanged). Restoring also restores whether a persistent load had changed since that step, so
    set loads after restoring, as the calls being repeated would. Saving uses the instance's scratch
    (QV_SOLVER_NEWTON: it evaluates the state), so save one instance from one thread at a time. */
 QV_API size_t qv_instance_snapshot_size(const qv_instance* instance);

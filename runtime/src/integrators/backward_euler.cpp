@@ -1,11 +1,11 @@
 // Backward Euler: first order and numerically damped. The minimising solver
 // (incremental_potential.h) by default; QV_SOLVER_NEWTON: Newton on the end-of-step velocity,
-// starting from the current one (or the minimiser: minimizedInstead()).
+// from zero, which ends the step at q (fixed_newton.h).
 #include <cstring>
 
 #include "../dynamics.h"
+#include "fixed_newton.h"
 #include "incremental_potential.h"
-#include "integrator.h"
 
 namespace quiver::rt {
 
@@ -34,11 +34,13 @@ qv_step_status stepBackwardEuler(qv_instance& s) {
   if (s.config.solver == QV_SOLVER_MINIMIZE) return minimizing(s);
   const double h = s.config.time_step;
   const int r = s.r;
+  double budget;
+  const double* J = beginFixedNewton(s, budget);
   const double *q = s.q, *v = s.v;
-  std::memcpy(s.end.v, v, sizeof(double) * r);
+  std::memset(s.end.v, 0, sizeof(double) * r);  // the first iteration at q itself
   for (int it = 0; it < s.config.newton_iterations; ++it, ++s.lastStep.newton_iterations) {
     for (int i = 0; i < r; ++i) s.end.q[i] = q[i] + h * s.end.v[i];
-    const double* J = evaluateForces(s, s.end.q);
+    if (it > 0) J = evaluateForces(s, s.end.q);
     dampingForces(s, s.end.v, s.work.damping);
     for (int i = 0; i < r; ++i)
       s.work.correction[i] = -((s.end.v[i] - v[i]) + h * (s.work.damping[i] + s.work.force[i] - s.loads.external(i)));
@@ -49,7 +51,7 @@ qv_step_status stepBackwardEuler(qv_instance& s) {
     s.end.a[i] = (s.end.v[i] - v[i]) / h;
     s.end.q[i] = q[i] + h * s.end.v[i];
   }
-  return endFixedNewton(s, minimizing);
+  return endFixedNewton(s, budget, minimizing);
 }
 
 } // namespace quiver::rt

@@ -1,11 +1,11 @@
 // Implicit Newmark, beta = 1/4, gamma = 1/2 (the trapezoidal rule; Barbic & James 2005). The
 // minimising solver (incremental_potential.h) by default; QV_SOLVER_NEWTON: Newton on the
-// end-of-step acceleration, starting from the last one (or the minimiser: minimizedInstead()).
+// end-of-step acceleration, from the one that ends the step at q (fixed_newton.h).
 #include <cstring>
 
 #include "../dynamics.h"
+#include "fixed_newton.h"
 #include "incremental_potential.h"
-#include "integrator.h"
 
 namespace quiver::rt {
 
@@ -44,17 +44,20 @@ qv_step_status stepImplicitNewmark(qv_instance& s) {
   // Soft contacts pin the deformation where they hold it, and the trapezoidal rule then flips its
   // velocity there every step (v' = 2 (q' - q) / h - v): fixed steps rang against a resting bar and,
   // at one or two iterations, fed it until it flew off. The minimiser's energy budget bounds them.
+  double budget;
+  const double* J = beginFixedNewton(s, budget);
   if (newmarkStepMinimized(s)) return minimizedInstead(s, minimizing);
   const double h = s.config.time_step, beta = kNewmarkBeta, gamma = kNewmarkGamma;
   const int r = s.r;
   const double *q = s.q, *v = s.v, *a = s.a;
-  std::memcpy(s.end.a, a, sizeof(double) * r);
+  // The first iteration at q itself: the end-of-step acceleration that puts the end there.
+  for (int i = 0; i < r; ++i) s.end.a[i] = -(v[i] / (beta * h) + (0.5 - beta) / beta * a[i]);
   for (int it = 0; it < s.config.newton_iterations; ++it, ++s.lastStep.newton_iterations) {
     for (int i = 0; i < r; ++i) {
-      s.end.q[i] = it == 0 ? newmarkGuess(s, i) : q[i] + h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * s.end.a[i]);
+      s.end.q[i] = q[i] + h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * s.end.a[i]);
       s.end.v[i] = v[i] + h * ((1 - gamma) * a[i] + gamma * s.end.a[i]);
     }
-    const double* J = evaluateForces(s, s.end.q);
+    if (it > 0) J = evaluateForces(s, s.end.q);
     dampingForces(s, s.end.v, s.work.damping);
     for (int i = 0; i < r; ++i)
       s.work.correction[i] = -(s.end.a[i] + s.work.damping[i] + s.work.force[i] - s.loads.external(i));
@@ -67,7 +70,7 @@ qv_step_status stepImplicitNewmark(qv_instance& s) {
     s.end.q[i] = q[i] + (h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * s.end.a[i]));
     s.end.v[i] = v[i] + h * ((1 - gamma) * a[i] + gamma * s.end.a[i]);
   }
-  return endFixedNewton(s, minimizing);
+  return endFixedNewton(s, budget, minimizing);
 }
 
 } // namespace quiver::rt

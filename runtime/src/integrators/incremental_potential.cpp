@@ -85,19 +85,6 @@ private:
   const int r_;
 };
 
-// H = |v|^2/2 + E + S - f^T q at this step's loads (v null: the potential alone).
-double stepEnergy(const qv_instance& s, const double* q, const double* v, double elastic) {
-  double kinetic = 0, external = 0, S = 0;
-  for (int i = 0; i < s.r; ++i) {
-    if (v) kinetic += 0.5 * v[i] * v[i];
-    external += s.loads.external(i) * q[i];
-  }
-  // The state forces' potential alone; the force they add is not needed here.
-  std::memset(s.work.stateForceSink, 0, sizeof(double) * s.r);
-  s.loads.addStateForces(q, s.work.stateForceSink, &S);
-  return kinetic + elastic + S - external;
-}
-
 // The budget holds: never end a step with more. Where the position alone holds more, draw it back
 // toward the start, whose potential is within the budget; the velocity then gets what is left.
 void holdToBudget(qv_instance& s, double budget, double* x, double* velocity, double& elastic, qv_step_report& report) {
@@ -133,6 +120,18 @@ void holdToBudget(qv_instance& s, double budget, double* x, double* velocity, do
 }
 
 } // namespace
+
+double stepEnergy(const qv_instance& s, const double* q, const double* v, double elastic) {
+  double kinetic = 0, external = 0, S = 0;
+  for (int i = 0; i < s.r; ++i) {
+    if (v) kinetic += 0.5 * v[i] * v[i];
+    external += s.loads.external(i) * q[i];
+  }
+  // The state forces' potential alone; the force they add is not needed here.
+  std::memset(s.work.stateForceSink, 0, sizeof(double) * s.r);
+  s.loads.addStateForces(q, s.work.stateForceSink, &S);
+  return kinetic + elastic + S - external;
+}
 
 void MinimizeTask::begin(qv_instance& s, const StepPredictor& p) {
   s_ = &s;

@@ -47,7 +47,7 @@ inline SystemScales minimizerSystem(const qv_instance& s, const StepPredictor& p
 
 // The most Newton iterations of a minimising step: newton_iterations (by default
 // kMinimizerIterations), or kMinimizerIterations for a QV_SOLVER_NEWTON step it took over
-// (integrator.h, minimizedInstead()), where newton_iterations counts fixed iterations.
+// (fixed_newton.h, minimizedInstead()), where newton_iterations counts fixed iterations.
 constexpr int kMinimizerIterations = 8;
 inline int maxIterations(const qv_instance& s) {
   return s.config.solver == QV_SOLVER_MINIMIZE ? s.config.newton_iterations : kMinimizerIterations;
@@ -85,6 +85,9 @@ private:
   PhiPoint at_, trial_;
   qv_step_status status_ = QV_STEP_OK;
 };
+
+// H = |v|^2/2 + E + S - f^T q at this step's loads (v null: the potential alone), E = `elastic`.
+double stepEnergy(const qv_instance& s, const double* q, const double* v, double elastic);
 
 // begin(), resume() until done, status().
 qv_step_status minimizeStep(qv_instance& s, const StepPredictor& predictor);

@@ -1,9 +1,6 @@
 #pragma once
 // Time integrators. Each lives in its own file as one function that advances an instance by one
 // step; adding one means its file, a value of qv_integrator and a row of kIntegrators.
-#include <cstring>
-
-#include "../elasticity.h"
 #include "../instance.h"
 #include "incremental_potential.h"
 
@@ -35,7 +32,7 @@ qv_step_status stepImplicitNewmark(qv_instance& s);
 StepPredictor beginNewmarkMinimization(qv_instance& s);
 qv_step_status endNewmarkMinimization(qv_instance& s, const StepPredictor& p, qv_step_status status);
 // Implicit Newmark's first guess at the end of the step, q + h v + h^2/2 a (the last acceleration
-// kept): where both solvers start, and where a group's preset is evaluated (step_many.h).
+// kept): where the minimiser starts, and where a group evaluates it (step_many.h).
 inline double newmarkGuess(const qv_instance& s, int i) {
   const double h = s.config.time_step;
   return s.q[i] + h * s.v[i] + 0.5 * h * h * s.a[i];
@@ -51,35 +48,6 @@ inline void newmarkNewtonScales(const qv_instance& s, double& c1, double& c2) {
   const double h = s.config.time_step;
   c1 = kNewmarkGamma * h;
   c2 = kNewmarkBeta * h * h;
-}
-// QV_SOLVER_NEWTON's way out, for both implicit integrators: a fixed Newton step whose system
-// large compression made indefinite, or whose end would move a vertex past max_displacement or is
-// not finite, is taken from the same start by the integrator's minimising step instead of being
-// solved by pivoting LU or reset to rest (under a push flipping near the soft bench bar's
-// resonance such steps threw it past max_displacement 171 times in 6000 steps; the minimiser
-// cannot add energy). The energy the fixed steps add stays: that bar still swings nine times as
-// far as under the minimiser.
-inline qv_step_status minimizedInstead(qv_instance& s, StepFunction minimizing) {
-  s.lastStep = qv_step_report{};
-  s.lastStep.minimized = 1;
-  // A group's preset evaluation is not whole once D below overwrites its stiffness.
-  s.work.presetValid = false;
-  s.work.presetFactor = LaneFactor{};
-  // Its energy budget and damping start from this state, as after qv_instance_set_state: fixed
-  // Newton steps keep no account of E(q) and D.
-  s.elasticEnergyAtState = elasticEnergy(*s.model, s.config.elasticity, s.q, s.work.polynomialScratch);
-  s.energySlack = 0;
-  s.dampingStiffnessAtState(s.dampingStiffness);
-  return minimizing(s);
-}
-// The end of a fixed Newton step (s.end): taken, or, past max_displacement or not finite, the
-// minimiser's step instead.
-inline qv_step_status endFixedNewton(qv_instance& s, StepFunction minimizing) {
-  if (!s.withinBounds(s.end.q, s.end.v, s.end.a)) return minimizedInstead(s, minimizing);
-  std::memcpy(s.q, s.end.q, sizeof(double) * s.r);
-  std::memcpy(s.v, s.end.v, sizeof(double) * s.r);
-  std::memcpy(s.a, s.end.a, sizeof(double) * s.r);
-  return QV_STEP_OK;
 }
 qv_step_status stepBackwardEuler(qv_instance& s);
 qv_step_status stepCentralDifferences(qv_instance& s);
