@@ -55,14 +55,8 @@ qv_step_status minimizedInstead(qv_instance& s, StepFunction minimizing) {
 qv_step_status endFixedNewton(qv_instance& s, double budget, StepFunction minimizing) {
   if (!s.withinBounds(s.end.q, s.end.v, s.end.a)) return minimizedInstead(s, minimizing);
   const int r = s.r;
-  // Damping's share, h v_mid^T C v_mid with C at the last iterate's K (never counted as a gain).
-  double* mid = s.work.midpointVelocity;
-  for (int i = 0; i < r; ++i) mid[i] = 0.5 * (s.v[i] + s.end.v[i]);
-  dampingForces(s, mid, s.work.damping);
-  double dissipated = 0;
-  for (int i = 0; i < r; ++i) dissipated += mid[i] * s.work.damping[i];
-  budget -= s.config.time_step * std::fmax(dissipated, 0.0);
-  s.elasticAllowance = budget - stepEnergy(s, s.end.q, s.end.v, 0.0);
+  // Damping with the last iterate's K, as the iterations damped.
+  s.elasticAllowance = budget - dampingShare(s, s.work.stiffness) - stepEnergy(s, s.end.q, s.end.v, 0.0);
   std::memcpy(s.q, s.end.q, sizeof(double) * r);
   std::memcpy(s.v, s.end.v, sizeof(double) * r);
   std::memcpy(s.a, s.end.a, sizeof(double) * r);

@@ -41,11 +41,11 @@ qv_step_status minimizing(qv_instance& s) {
 
 qv_step_status stepImplicitNewmark(qv_instance& s) {
   if (s.config.solver == QV_SOLVER_MINIMIZE) return minimizing(s);
+  double budget;
+  const double* J = beginFixedNewton(s, budget);
   // Soft contacts pin the deformation where they hold it, and the trapezoidal rule then flips its
   // velocity there every step (v' = 2 (q' - q) / h - v): fixed steps rang against a resting bar and,
   // at one or two iterations, fed it until it flew off. The minimiser's energy budget bounds them.
-  double budget;
-  const double* J = beginFixedNewton(s, budget);
   if (newmarkStepMinimized(s)) return minimizedInstead(s, minimizing);
   const double h = s.config.time_step, beta = kNewmarkBeta, gamma = kNewmarkGamma;
   const int r = s.r;

@@ -133,6 +133,13 @@ double stepEnergy(const qv_instance& s, const double* q, const double* v, double
   return kinetic + elastic + S - external;
 }
 
+double dampingShare(qv_instance& s, const double* K) {
+  double* mid = s.work.midpointVelocity;
+  for (int i = 0; i < s.r; ++i) mid[i] = 0.5 * (s.v[i] + s.end.v[i]);
+  dampingForces(s, K, mid, s.work.damping);
+  return s.config.time_step * std::fmax(dot(mid, s.work.damping, s.r), 0.0);
+}
+
 void MinimizeTask::begin(qv_instance& s, const StepPredictor& p) {
   s_ = &s;
   p_ = p;
@@ -223,12 +230,7 @@ void MinimizeTask::iterate() {
 
 void MinimizeTask::finish() {
   qv_instance& s = *s_;
-  const int r = s.r;
-  // Damping's share: h v_mid^T C v_mid, exact for the trapezoidal rule's linear damping.
-  double* mid = s.work.midpointVelocity;
-  for (int i = 0; i < r; ++i) mid[i] = 0.5 * (s.v[i] + s.end.v[i]);
-  dampingForces(s, s.dampingStiffness, mid, s.work.damping);
-  for (int i = 0; i < r; ++i) budget_ -= p_.h * mid[i] * s.work.damping[i];
+  budget_ -= dampingShare(s, s.dampingStiffness);
   holdToBudget(s, budget_, s.end.q, s.end.v, elastic_, s.lastStep);
   // A step held back forfeits the slack: what it removed is not to be won back.
   s.energySlack = s.lastStep.held_back ? 0.0 : std::fmax(0.0, budget_ - stepEnergy(s, s.end.q, s.end.v, elastic_));

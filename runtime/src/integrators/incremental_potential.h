@@ -89,6 +89,10 @@ private:
 // H = |v|^2/2 + E + S - f^T q at this step's loads (v null: the potential alone), E = `elastic`.
 double stepEnergy(const qv_instance& s, const double* q, const double* v, double elastic);
 
+// What damping dissipates over the step from s.v to s.end.v: h v_mid^T C v_mid, C = alpha I + beta K
+// (exact for the trapezoidal rule's linear damping; never below zero, should K be indefinite).
+double dampingShare(qv_instance& s, const double* K);
+
 // begin(), resume() until done, status().
 qv_step_status minimizeStep(qv_instance& s, const StepPredictor& predictor);
 
