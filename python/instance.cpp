@@ -365,7 +365,7 @@ rest), the worst of the steps taken; last_step describes the last.)")
         std::vector<double> aligned(bytes.size() / sizeof(double) + 1);
         std::memcpy(aligned.data(), bytes.data(), bytes.size());
         if (qv_instance_restore_snapshot(self.use(), aligned.data(), bytes.size()) != QV_OK)
-          throw py::value_error("snapshot is not of a model with this instance's r, or its damping stiffness is not positive definite");
+          throw py::value_error("snapshot is not of a model with this instance's r, holds a value that is not finite, or its damping stiffness is not positive definite");
       }, py::arg("snapshot"))
       .def("add_vertex_force", [](Instance& self, long long vertex, py::handle force) {
         checkVertex(vertex, self.model->info().vertex_count);

@@ -113,6 +113,7 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
   v = c.take<double>(r);
   a = c.take<double>(r);
   dampingStiffness = c.take<double>(rr);
+  previousQ = c.take<double>(r);
   loads.carve(c, r, config.max_constraints, flying());
   end.q = c.take<double>(r);
   end.v = c.take<double>(r);
@@ -152,10 +153,17 @@ void qv_instance::rest() {
   std::memset(a, 0, sizeof(double) * r);
   elasticEnergyAtState = 0;
   energySlack = 0;
-  elasticAllowance = 0;
+  openEnergyAccount(0);
   quiver::rt::dampWithStiffness(*this, model->restStiffness, dampingStiffness);
   contacts.clear();
   if (flying()) frame.goHome();
+}
+
+void qv_instance::openEnergyAccount(double elastic) {
+  elasticAllowance = elastic + energySlack;
+  exactEndChecks = 0;
+  std::memcpy(previousQ, q, sizeof(double) * r);
+  previousElastic = elastic;
 }
 
 bool qv_instance::withinBounds(const double* endQ, const double* endV, const double* endA) const {
@@ -290,8 +298,9 @@ void qv_instance::setState(const double* newQ, const double* newV, const double*
   if (newV) std::memcpy(v, newV, sizeof(double) * r);
   const bool consistentA = !newA && (newQ || newV);
   if (newQ || consistentA) quiver::rt::evaluateForces(*this, q);  // R(q) + S(q), K(q)
-  // Fixed Newton steps keep E(q) only in their account, which a new velocity starts anew too.
-  if (newQ || !minimizes())
+  // Fixed Newton steps keep E(q) only in their account, which a new q or velocity opens anew.
+  const bool newAccount = keepsEnergyAccount() && (newQ || newV);
+  if (newQ || newAccount)
     elasticEnergyAtState = quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
   if (newQ) quiver::rt::dampWithStiffness(*this, work.stiffness, dampingStiffness);
   if (newA) {
@@ -304,7 +313,7 @@ void qv_instance::setState(const double* newQ, const double* newV, const double*
     for (int i = 0; i < r; ++i) a[i] = loads.gravityForce[i] - work.force[i] - work.damping[i];
   }
   energySlack = 0;
-  elasticAllowance = elasticEnergyAtState;
+  if (newAccount) openEnergyAccount(elasticEnergyAtState);
 }
 
 void qv_instance::dampingStiffnessAtState(double* D) const {
@@ -319,11 +328,12 @@ void qv_instance::saveSnapshot(double* out) const {
   std::memcpy(out + 1 + 2 * r, a, sizeof(double) * r);
   // The minimiser's energy budget. Fixed Newton steps leave E(q) to their next step: it is
   // evaluated here, and their account written as the slack it leaves (negative: an excess), which a
-  // minimising instance restored from it owes too; their own takes the allowance at the end.
-  const bool budgeted = minimizes();
+  // minimising instance restored from it owes too; their own reads the account at the end. Other
+  // instances write the account a fixed Newton instance opens at this state.
+  const bool budgeted = minimizes(), account = keepsEnergyAccount();
   const double elastic = budgeted ? elasticEnergyAtState : quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
   out[1 + 3 * r] = elastic;
-  out[2 + 3 * r] = budgeted ? energySlack : elasticAllowance - elastic;
+  out[2 + 3 * r] = budgeted ? energySlack : account ? elasticAllowance - elastic : 0.0;
   double* f = out + 3 + 3 * r;
   if (flying()) {
     std::memcpy(f, frame.position, 3 * sizeof(double));
@@ -346,14 +356,19 @@ void qv_instance::saveSnapshot(double* out) const {
   // What the next step compares its loads with (Loads::changedSinceLastStep()).
   std::memcpy(f, loads.lastStepForce, sizeof(double) * r);
   f[r] = loads.changed ? 1.0 : 0.0;
-  f[r + 1] = budgeted ? elasticEnergyAtState + energySlack : elasticAllowance;
+  f[r + 1] = account ? elasticAllowance : elastic + out[2 + 3 * r];
+  f[r + 2] = account ? previousElastic : elastic;
+  std::memcpy(f + r + 3, account ? previousQ : q, sizeof(double) * r);
+  f[2 * r + 3] = account ? exactEndChecks : 0;
 }
 
 bool qv_instance::restoreSnapshot(const double* in) {
   if (in[0] != r) return false;
-  // A state, a budget or a frame that is not finite would only be reset by the next step.
+  // A state, a budget, a frame or an account that is not finite would only be reset by the next
+  // step. The last step's forces may hold one (a step that reset): it only marks a change.
+  const size_t lastForces = 3 + 3 * static_cast<size_t>(r) + (flying() ? 16 : 0) + static_cast<size_t>(r) * (r + 1) / 2;
   for (size_t i = 1; i < snapshotSize() / sizeof(double); ++i)
-    if (!std::isfinite(in[i])) return false;
+    if ((i < lastForces || i >= lastForces + r) && !std::isfinite(in[i])) return false;
   // D must be positive definite, or the damping would add energy: checked before anything changes.
   const double* savedD = in + 3 + 3 * r + (flying() ? 16 : 0);
   for (int i = 0, k = 0; i < r; ++i)
@@ -370,6 +385,9 @@ bool qv_instance::restoreSnapshot(const double* in) {
   elasticEnergyAtState = in[1 + 3 * r];
   energySlack = in[2 + 3 * r];
   elasticAllowance = savedLoads[r + 1];
+  previousElastic = savedLoads[r + 2];
+  std::memcpy(previousQ, savedLoads + r + 3, sizeof(double) * r);
+  exactEndChecks = static_cast<int>(std::fmin(std::fmax(savedLoads[2 * r + 3], 0.0), 1e6));
   contacts.clear();  // the snapshot does not carry them: the next step's contacts start cold
   if (flying()) {
     const double* f = in + 3 + 3 * r;

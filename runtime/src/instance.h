@@ -79,10 +79,14 @@ struct qv_instance {
   double *q, *v, *a;
   double elasticEnergyAtState;  // E(q) for the energy budget (a fixed Newton step's end leaves it stale)
   double energySlack;           // energy the discretisation lost that a later step may win back
-  // QV_SOLVER_NEWTON's energy account (integrators/fixed_newton.h): the most E(q) the state may hold
-  // within the last step's budget, which the next fixed step's start settles (E(q) plus the slack
-  // where no fixed step left it: a new state, a step the minimiser took).
+  // QV_SOLVER_NEWTON's energy account (integrators/fixed_newton.h), which the next fixed step's start
+  // settles: the most E(q) the state may hold within the last step's budget, and where that step
+  // started (q and E(q)), toward which the state is drawn back where its position alone holds more.
+  // Opened at the state itself (openEnergyAccount()) where no fixed step left it.
   double elasticAllowance;
+  double* previousQ;
+  double previousElastic;
+  int exactEndChecks;  // steps left whose ends are held to the budget at once (fixed_newton.h)
   // D, r x r: the minimising solver's Rayleigh damping C = alpha I + beta D through a step. K(q) at
   // the step's start, shifted to positive definite where compression made it indefinite
   // (dampWithStiffness(), dynamics.h).
@@ -118,6 +122,8 @@ struct qv_instance {
   bool softContact = false;
 
   void carve(quiver::rt::BlockCarver& c);
+  // The fixed Newton account at this state, E(q) = `elastic`, with the energy slack kept.
+  void openEnergyAccount(double elastic);
   void rest();
   bool healthy() const;
   // A step's end (q, v, a): finite, and |q| within maxQ.
@@ -137,6 +143,10 @@ struct qv_instance {
   bool minimizes() const {
     return config.solver == QV_SOLVER_MINIMIZE && config.integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES;
   }
+  // Its steps are fixed Newton steps, which keep the energy account (integrators/fixed_newton.h).
+  bool keepsEnergyAccount() const {
+    return config.solver == QV_SOLVER_NEWTON && config.integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES;
+  }
   // A world force on a vertex: on q (and, in flight, on the frame).
   void addVertexForce(int vertex, const double force[3]);
   void setGravity(const double acceleration[3]);
@@ -151,10 +161,12 @@ struct qv_instance {
   // The snapshot: r, then q, v, a, E(q) and the energy slack, then in flight the frame (position,
   // orientation, velocity, angular momentum, last body omega), then D's upper triangle row by row,
   // then the last step's per-step forces and whether a persistent load changed since (1 or 0), then
-  // the elastic allowance, as doubles: all a step reads beyond the caller's calls.
+  // the fixed Newton account (the elastic allowance, the previous E(q) and q, the exact end checks
+  // left), as doubles: all a
+  // step reads beyond the caller's calls.
   size_t snapshotSize() const {
     const size_t n = static_cast<size_t>(r);
-    return sizeof(double) * (3 * n + 3 + (flying() ? 16 : 0) + n * (n + 1) / 2 + n + 2);
+    return sizeof(double) * (3 * n + 3 + (flying() ? 16 : 0) + n * (n + 1) / 2 + 2 * n + 4);
   }
   void saveSnapshot(double* out) const;
   bool restoreSnapshot(const double* in);

@@ -152,6 +152,31 @@ class RobustStep(unittest.TestCase):
                     # lower bound, on a model of its own.
 
 
+    def test_fixed_newton_energy_stays_within_the_release_but_for_single_steps(self):
+        """The fixed Newton step (one iteration) holds the same budget one step late: a step may end
+        above it until the next starts, and after such an excess the next 60 steps are held at once
+        (runtime/src/integrators/fixed_newton.h). Measured: 5 of 480 step ends above the release's
+        energy on the jittered beam, none on bar-2523, and both end below it; runtime 0.11 ended 84%
+        and 99% of them above, with a median of 33 and 9e6 times the release energy."""
+        if not self.models:
+            self.skipTest("no mesh to test")
+        for name, (model, L, _) in self.models.items():
+            for integrator in ("newmark", "euler"):
+                with self.subTest(mesh=name, integrator=integrator):
+                    j, rows = self.sim(model, L, "--hold", 120, "--steps", 600, "--dt", 1 / 120, "--stiffness", 1e5,
+                                       "--twist", 180, "--alpha", 0, "--beta", 0, "--integrator", integrator,
+                                       "--solver", "newton", "--newton", 1)
+                    energy = np.array([float(r["kinetic_J"]) + float(r["elastic_J"]) for r in rows])
+                    released, after = energy[119], energy[120:]
+                    above = np.mean(after > released * 1.01)
+                    print(f"{name}, {integrator}, fixed Newton: energy at release {released:.4g} J, {above:.1%} of the "
+                          f"steps after it end above, median {np.median(after) / released:.3g} of it, last "
+                          f"{after[-1] / released:.3g}; {j['held_back_steps']} drawn back")
+                    self.assertEqual(j["resets"], 0)
+                    self.assertLess(above, 0.03)
+                    self.assertLess(np.median(after), released)
+                    self.assertLess(after[-1], released * 1.01)
+
 class SpreadSpectrum(unittest.TestCase):
     @classmethod
     def setUpClass(cls):

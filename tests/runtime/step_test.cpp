@@ -271,6 +271,51 @@ TEST(Step, FixedNewtonUnderAFlippingPushSwingsAsTheMinimiser) {
   EXPECT_GT(largest[QV_SOLVER_NEWTON], 0.5 * largest[QV_SOLVER_MINIMIZE]);
 }
 
+// A fixed Newton instance's snapshot carries its energy account (fixed_newton.h: the allowance,
+// where the last step started, the exact end checks left). Under the flipping push the budget takes
+// energy out; a fresh instance restored from a snapshot taken mid-way repeats the steps bit for bit.
+TEST(Step, AFixedNewtonInstanceRestoredFromItsSnapshotRepeatsItsStepsBitForBit) {
+  test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  const int r = m.info.r;
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  config.solver = QV_SOLVER_NEWTON;
+  config.newton_iterations = 1;
+  const double g[3] = {0, 0, -QV_STANDARD_GRAVITY};
+  const double amplitude = 2 * QV_STANDARD_GRAVITY * std::fabs(qv_model_gravity(m.model)[2 * r]);
+  const int period = static_cast<int>(std::lround(0.5 / config.time_step));
+  double removed = 0;
+  const auto run = [&](qv_instance* s, int from, int to) {
+    std::vector<double> push(r, 0.0);
+    for (int step = from; step < to; ++step) {
+      push[0] = (step / period) % 2 ? amplitude : -amplitude;
+      qv_instance_add_reduced_force(s, push.data());
+      qv_instance_step(s);
+      qv_step_report report;
+      qv_instance_last_step(s, &report);
+      removed += report.energy_removed;
+    }
+  };
+  Instance a(m.model, config), b(m.model, config);
+  qv_instance_set_gravity(a.s, g);
+  qv_instance_set_gravity(b.s, g);
+  // Saved a step after the push flipped and the budget drew the state back (step 631): the account
+  // then carries slack and exact end checks into the steps repeated.
+  run(a.s, 0, 632);
+  std::vector<char> snapshot(qv_instance_snapshot_size(a.s));
+  qv_instance_save_snapshot(a.s, snapshot.data());
+  removed = 0;
+  run(a.s, 632, 1200);
+  EXPECT_GT(removed, 0.0) << "the budget must act while the steps are repeated";
+  ASSERT_EQ(qv_instance_restore_snapshot(b.s, snapshot.data(), snapshot.size()), QV_OK);
+  run(b.s, 632, 1200);
+  std::vector<double> sa(3 * r), sb(3 * r);
+  qv_instance_get_state(a.s, sa.data(), sa.data() + r, sa.data() + 2 * r);
+  qv_instance_get_state(b.s, sb.data(), sb.data() + r, sb.data() + 2 * r);
+  EXPECT_EQ(0, std::memcmp(sa.data(), sb.data(), sizeof(double) * sa.size()));
+}
+
 TEST(Step, DeterministicAndStateRoundTrips) {
   test::TestModel m;
   ASSERT_NE(m.model, nullptr);
@@ -296,14 +341,20 @@ TEST(Step, DeterministicAndStateRoundTrips) {
   EXPECT_EQ(qv_instance_restore_snapshot(b.s, saved.data(), saved.size() * sizeof(double) - 1), QV_ERROR_INVALID_ARGUMENT);
   // A damping stiffness that is not positive definite (it would add energy) is refused, and b is
   // left as it was. D's upper triangle ends with its (r, r) entry, before the last step's r forces,
-  // the load-changed flag and the elastic allowance that end the snapshot.
+  // the load-changed flag and the fixed Newton account (4 + r values) that end the snapshot.
   std::vector<double> spoiled = saved;
-  spoiled[spoiled.size() - r - 3] = -1;
+  const size_t lastForces = spoiled.size() - 2 * r - 4;
+  spoiled[lastForces - 1] = -1;
   EXPECT_EQ(qv_instance_restore_snapshot(b.s, spoiled.data(), spoiled.size() * sizeof(double)), QV_ERROR_INVALID_ARGUMENT);
-  // So is one with a value that is not finite (here the elastic allowance, the last).
+  // So is one with a value that is not finite (the account's last), but for the last step's forces,
+  // where one only marks a change (a step that reset keeps them).
   spoiled = saved;
   spoiled.back() = NAN;
   EXPECT_EQ(qv_instance_restore_snapshot(b.s, spoiled.data(), spoiled.size() * sizeof(double)), QV_ERROR_INVALID_ARGUMENT);
+  spoiled = saved;
+  spoiled[lastForces] = NAN;
+  Instance c(m.model, config);
+  EXPECT_EQ(qv_instance_restore_snapshot(c.s, spoiled.data(), spoiled.size() * sizeof(double)), QV_OK);
   qv_instance_get_state(b.s, sb.data(), sb.data() + r, sb.data() + 2 * r);
   EXPECT_EQ(0, std::memcmp(sa.data(), sb.data(), sizeof(double) * sa.size()));
   ASSERT_EQ(qv_instance_restore_snapshot(b.s, saved.data(), saved.size() * sizeof(double)), QV_OK);

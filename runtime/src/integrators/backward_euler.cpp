@@ -44,7 +44,7 @@ qv_step_status stepBackwardEuler(qv_instance& s) {
     dampingForces(s, s.end.v, s.work.damping);
     for (int i = 0; i < r; ++i)
       s.work.correction[i] = -((s.end.v[i] - v[i]) + h * (s.work.damping[i] + s.work.force[i] - s.loads.external(i)));
-    if (!solveNewton(s, J, h, h * h)) return minimizedInstead(s, minimizing);
+    if (!solveNewton(s, J, h, h * h)) return minimizedInstead(s, minimizing, it == 0);
     for (int i = 0; i < r; ++i) s.end.v[i] += s.work.correction[i];
   }
   for (int i = 0; i < r; ++i) {

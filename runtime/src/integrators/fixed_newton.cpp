@@ -4,25 +4,30 @@
 #include <cstring>
 
 #include "../dynamics.h"
+#include "../elasticity.h"
 
 namespace quiver::rt {
 
 namespace {
 
-// Settles the account with E(q), the elastic energy at the state: an excess leaves the velocity (all
-// of it when the position alone holds more: the step starts from rest), a shortfall is slack.
-void settleEnergyAccount(qv_instance& s, double elastic) {
-  const double excess = elastic - s.elasticAllowance;
-  if (!(excess > 0)) {
-    s.energySlack = -excess;
-    return;
+// After a step found more energy than its budget, this many steps hold their ends to it at once,
+// at one more evaluation each: where one iteration overshoots, it tends to again.
+constexpr int kExactEndChecks = 60;
+
+// Settles the account with E(q) (s.elasticEnergyAtState) at this step's loads: a shortfall is slack;
+// an excess beyond rounding is taken out as the minimiser's budget takes it out (holdToBudget()),
+// with the previous step's start in the role of the start. Returns whether q moved.
+bool settleEnergyAccount(qv_instance& s) {
+  const double excess = s.elasticEnergyAtState - s.elasticAllowance;
+  if (!(excess > 1e-12 * (std::fabs(s.elasticEnergyAtState) + std::fabs(s.elasticAllowance)))) {
+    s.energySlack = std::fmax(-excess, 0.0);
+    return false;
   }
   s.energySlack = 0;
-  double kinetic = 0;
-  for (int i = 0; i < s.r; ++i) kinetic += 0.5 * s.v[i] * s.v[i];
-  const double keep = excess < kinetic ? std::sqrt((kinetic - excess) / kinetic) : 0.0;
-  for (int i = 0; i < s.r; ++i) s.v[i] *= keep;
-  s.lastStep.energy_removed = kinetic * (1 - keep * keep);
+  s.exactEndChecks = kExactEndChecks;
+  const double budget = stepEnergy(s, s.q, s.v, s.elasticEnergyAtState) - excess;
+  holdToBudget(s, budget, s.previousQ, s.previousElastic, s.q, s.v, s.elasticEnergyAtState, s.lastStep);
+  return s.lastStep.held_back != 0;
 }
 
 } // namespace
@@ -30,33 +35,48 @@ void settleEnergyAccount(qv_instance& s, double elastic) {
 const double* beginFixedNewton(qv_instance& s, double& budget) {
   elasticityAt(s, s.q, &s.elasticEnergyAtState, s.work.force);
   const double* J = s.loads.addStateForces(s.q, s.work.force);
-  settleEnergyAccount(s, s.elasticEnergyAtState);
+  if (settleEnergyAccount(s)) {  // drawn back: the step starts from there
+    elasticityAt(s, s.q, &s.elasticEnergyAtState, s.work.force);
+    J = s.loads.addStateForces(s.q, s.work.force);
+  }
   // As the minimiser's (MinimizeTask::begin()): what was lost under other loads is not owed.
   if (s.loads.changedSinceLastStep()) s.energySlack = 0;
   budget = stepEnergy(s, s.q, s.v, s.elasticEnergyAtState) + s.energySlack;
   return J;
 }
 
-qv_step_status minimizedInstead(qv_instance& s, StepFunction minimizing) {
-  const double energyRemoved = s.lastStep.energy_removed;  // by beginFixedNewton()
+qv_step_status minimizedInstead(qv_instance& s, StepFunction minimizing, bool stiffnessAtState) {
+  const qv_step_report settled = s.lastStep;  // what beginFixedNewton() took out
   s.lastStep = qv_step_report{};
   s.lastStep.minimized = 1;
   // A group's preset evaluation is not whole once D below overwrites its stiffness.
   s.work.presetValid = false;
   s.work.presetFactor = LaneFactor{};
   // Its damping starts from this state, as after qv_instance_set_state: fixed Newton steps keep no D.
-  s.dampingStiffnessAtState(s.dampingStiffness);
+  if (stiffnessAtState)
+    dampWithStiffness(s, s.work.stiffness, s.dampingStiffness);
+  else
+    s.dampingStiffnessAtState(s.dampingStiffness);
   const qv_step_status status = minimizing(s);
-  s.lastStep.energy_removed += energyRemoved;
-  s.elasticAllowance = s.elasticEnergyAtState + s.energySlack;
+  s.lastStep.energy_removed += settled.energy_removed;
+  s.lastStep.held_back |= settled.held_back;
+  s.openEnergyAccount(s.elasticEnergyAtState);
   return status;
 }
 
 qv_step_status endFixedNewton(qv_instance& s, double budget, StepFunction minimizing) {
-  if (!s.withinBounds(s.end.q, s.end.v, s.end.a)) return minimizedInstead(s, minimizing);
+  if (!s.withinBounds(s.end.q, s.end.v, s.end.a)) return minimizedInstead(s, minimizing, false);
   const int r = s.r;
   // Damping with the last iterate's K, as the iterations damped.
-  s.elasticAllowance = budget - dampingShare(s, s.work.stiffness) - stepEnergy(s, s.end.q, s.end.v, 0.0);
+  budget -= dampingShare(s, s.work.stiffness);
+  if (s.exactEndChecks > 0) {
+    --s.exactEndChecks;
+    double elastic = elasticEnergy(*s.model, s.config.elasticity, s.end.q, s.work.polynomialScratch);
+    holdToBudget(s, budget, s.q, s.elasticEnergyAtState, s.end.q, s.end.v, elastic, s.lastStep);
+  }
+  s.elasticAllowance = budget - stepEnergy(s, s.end.q, s.end.v, 0.0);
+  std::memcpy(s.previousQ, s.q, sizeof(double) * r);
+  s.previousElastic = s.elasticEnergyAtState;
   std::memcpy(s.q, s.end.q, sizeof(double) * r);
   std::memcpy(s.v, s.end.v, sizeof(double) * r);
   std::memcpy(s.a, s.end.a, sizeof(double) * r);

@@ -46,7 +46,7 @@ qv_step_status stepImplicitNewmark(qv_instance& s) {
   // Soft contacts pin the deformation where they hold it, and the trapezoidal rule then flips its
   // velocity there every step (v' = 2 (q' - q) / h - v): fixed steps rang against a resting bar and,
   // at one or two iterations, fed it until it flew off. The minimiser's energy budget bounds them.
-  if (newmarkStepMinimized(s)) return minimizedInstead(s, minimizing);
+  if (newmarkStepMinimized(s)) return minimizedInstead(s, minimizing, true);
   const double h = s.config.time_step, beta = kNewmarkBeta, gamma = kNewmarkGamma;
   const int r = s.r;
   const double *q = s.q, *v = s.v, *a = s.a;
@@ -63,7 +63,7 @@ qv_step_status stepImplicitNewmark(qv_instance& s) {
       s.work.correction[i] = -(s.end.a[i] + s.work.damping[i] + s.work.force[i] - s.loads.external(i));
     double c1, c2;
     newmarkNewtonScales(s, c1, c2);
-    if (!solveNewton(s, J, c1, c2)) return minimizedInstead(s, minimizing);
+    if (!solveNewton(s, J, c1, c2)) return minimizedInstead(s, minimizing, it == 0);
     for (int i = 0; i < r; ++i) s.end.a[i] += s.work.correction[i];
   }
   for (int i = 0; i < r; ++i) {

@@ -85,40 +85,6 @@ private:
   const int r_;
 };
 
-// The budget holds: never end a step with more. Where the position alone holds more, draw it back
-// toward the start, whose potential is within the budget; the velocity then gets what is left.
-void holdToBudget(qv_instance& s, double budget, double* x, double* velocity, double& elastic, qv_step_report& report) {
-  const int r = s.r;
-  if (stepEnergy(s, x, nullptr, elastic) > budget) {
-    // Bisection on x(t) = q + t (x - q) for the farthest t whose potential is within the budget
-    // (t = 0, the start, is); 12 halvings leave t within 1/4096 of it.
-    double* farEnd = s.work.segmentEnd;
-    std::memcpy(farEnd, x, sizeof(double) * r);
-    double within = 0, beyond = 1, withinElastic = s.elasticEnergyAtState;
-    for (int cut = 0; cut < 12; ++cut) {
-      const double t = 0.5 * (within + beyond);
-      for (int i = 0; i < r; ++i) x[i] = s.q[i] + t * (farEnd[i] - s.q[i]);
-      const double e = elasticEnergy(*s.model, s.config.elasticity, x, s.work.polynomialScratch);
-      if (stepEnergy(s, x, nullptr, e) <= budget) {
-        within = t;
-        withinElastic = e;
-      } else {
-        beyond = t;
-      }
-    }
-    for (int i = 0; i < r; ++i) x[i] = s.q[i] + within * (farEnd[i] - s.q[i]);
-    elastic = withinElastic;
-    report.held_back = 1;
-  }
-  const double energyAfter = stepEnergy(s, x, velocity, elastic);
-  if (energyAfter > budget) {
-    const double kinetic = 0.5 * dot(velocity, velocity, r), potential = energyAfter - kinetic;
-    const double keep = potential < budget && kinetic > 0 ? std::sqrt((budget - potential) / kinetic) : 0.0;
-    for (int i = 0; i < r; ++i) velocity[i] *= keep;
-    report.energy_removed = kinetic * (1 - keep * keep);
-  }
-}
-
 } // namespace
 
 double stepEnergy(const qv_instance& s, const double* q, const double* v, double elastic) {
@@ -131,6 +97,39 @@ double stepEnergy(const qv_instance& s, const double* q, const double* v, double
   std::memset(s.work.stateForceSink, 0, sizeof(double) * s.r);
   s.loads.addStateForces(q, s.work.stateForceSink, &S);
   return kinetic + elastic + S - external;
+}
+
+void holdToBudget(qv_instance& s, double budget, const double* start, double startElastic, double* x, double* velocity,
+                  double& elastic, qv_step_report& report) {
+  const int r = s.r;
+  if (stepEnergy(s, x, nullptr, elastic) > budget) {
+    // Bisection on x(t) = start + t (x - start) for the farthest t whose potential is within the budget
+    // (t = 0, the start, is); 12 halvings leave t within 1/4096 of it.
+    double* farEnd = s.work.segmentEnd;
+    std::memcpy(farEnd, x, sizeof(double) * r);
+    double within = 0, beyond = 1, withinElastic = startElastic;
+    for (int cut = 0; cut < 12; ++cut) {
+      const double t = 0.5 * (within + beyond);
+      for (int i = 0; i < r; ++i) x[i] = start[i] + t * (farEnd[i] - start[i]);
+      const double e = elasticEnergy(*s.model, s.config.elasticity, x, s.work.polynomialScratch);
+      if (stepEnergy(s, x, nullptr, e) <= budget) {
+        within = t;
+        withinElastic = e;
+      } else {
+        beyond = t;
+      }
+    }
+    for (int i = 0; i < r; ++i) x[i] = start[i] + within * (farEnd[i] - start[i]);
+    elastic = withinElastic;
+    report.held_back = 1;
+  }
+  const double energyAfter = stepEnergy(s, x, velocity, elastic);
+  if (energyAfter > budget) {
+    const double kinetic = 0.5 * dot(velocity, velocity, r), potential = energyAfter - kinetic;
+    const double keep = potential < budget && kinetic > 0 ? std::sqrt((budget - potential) / kinetic) : 0.0;
+    for (int i = 0; i < r; ++i) velocity[i] *= keep;
+    report.energy_removed = kinetic * (1 - keep * keep);
+  }
 }
 
 double dampingShare(qv_instance& s, const double* K) {
@@ -231,7 +230,7 @@ void MinimizeTask::iterate() {
 void MinimizeTask::finish() {
   qv_instance& s = *s_;
   budget_ -= dampingShare(s, s.dampingStiffness);
-  holdToBudget(s, budget_, s.end.q, s.end.v, elastic_, s.lastStep);
+  holdToBudget(s, budget_, s.q, s.elasticEnergyAtState, s.end.q, s.end.v, elastic_, s.lastStep);
   // A step held back forfeits the slack: what it removed is not to be won back.
   s.energySlack = s.lastStep.held_back ? 0.0 : std::fmax(0.0, budget_ - stepEnergy(s, s.end.q, s.end.v, elastic_));
   s.elasticEnergyAtState = elastic_;

@@ -89,6 +89,12 @@ private:
 // H = |v|^2/2 + E + S - f^T q at this step's loads (v null: the potential alone), E = `elastic`.
 double stepEnergy(const qv_instance& s, const double* q, const double* v, double elastic);
 
+// The budget holds: never end a step with more. Where the position x alone holds more, draw it back
+// toward `start` (E = startElastic), whose potential is within the budget, and say so
+// (report.held_back); the velocity then gets what is left (report.energy_removed). `elastic`: E(x), in and out.
+void holdToBudget(qv_instance& s, double budget, const double* start, double startElastic, double* x, double* velocity,
+                  double& elastic, qv_step_report& report);
+
 // What damping dissipates over the step from s.v to s.end.v: h v_mid^T C v_mid, C = alpha I + beta K
 // (exact for the trapezoidal rule's linear damping; never below zero, should K be indefinite).
 double dampingShare(qv_instance& s, const double* K);
