@@ -201,8 +201,9 @@ TEST(Step, AFixedNewtonStepThatWouldBlowUpIsTakenByTheMinimiserAndSaysSo) {
     qv_instance_get_state(bent.s, q.data(), v.data(), a.data());
     ASSERT_GT(q.norm(), 0.0);
     qv_instance_set_state(same.s, q.data(), v.data(), a.data());
-    // A snapshot of it carries the budget a minimising instance starts from that state, as after
-    // set_state (the fixed Newton instance's own is stale): restored, the two step alike.
+    // A snapshot of it carries E(q), which a minimising instance restored from it budgets from as
+    // after set_state, and the slack the fixed Newton account leaves (the budget does not bind here,
+    // under gravity): restored, the two step alike.
     std::vector<char> snapshot(qv_instance_snapshot_size(bent.s));
     qv_instance_save_snapshot(bent.s, snapshot.data());
     Instance restored(m.model, alone), fresh(m.model, alone);
