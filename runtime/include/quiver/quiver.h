@@ -167,8 +167,8 @@ typedef enum qv_solver {
                              back toward the last step's start; so a state handed out may hold more than its budget
                              for one step, after which the next 60 steps are held to it at their ends at one more
                              evaluation each (released undamped from a 180-degree twist at one iteration, a sliver
-                             beam's energy exceeded that at the release at 5 of 480 step ends, the first at 2800
-                             times it; 84% of them, and a runaway, in runtime 0.11). Where strains are large (stiff
+                             beam's energy exceeded that at the release at 5 of 480 step ends, at most 8.2 times
+                             it; 84% of them, and a runaway, in runtime 0.11). Where strains are large (stiff
                              springs, large twists, long time steps, sudden loads and releases) the iterations can
                              diverge: a step whose system is not positive definite, or whose end may move a vertex
                              farther than max_displacement (or, under implicit Newmark, with soft contacts in its
@@ -255,9 +255,10 @@ typedef struct qv_step_report {
   double gradient;         /* QV_SOLVER_MINIMIZE: |gradient| / force scale at the end */
   int held_back;           /* 1 when the end position alone held more energy than the step may end with, so it was
                               drawn back toward the start (the velocity keeps what is left); QV_SOLVER_NEWTON: the
-                              last step's end, at this step's start */
+                              last step's end, at this step's start, or, after an excess, this step's end */
   double energy_removed;   /* kinetic energy (J) the step took out so as not to add energy (QV_SOLVER_NEWTON: at its
-                              start, what the step before ended with beyond its budget) */
+                              start, of what the step before ended with beyond its budget, and, after such an
+                              excess, at its end) */
   int minimized;           /* QV_SOLVER_NEWTON: 1 when the minimising solver took the step (the Newton system was not
                               positive definite, the step may have moved a vertex past max_displacement, or, under
                               implicit Newmark, soft contacts were in its solve); the fields above then describe its step */
@@ -319,7 +320,8 @@ QV_API void qv_instance_set_state(qv_instance* instance, const double* q, const 
    budget compares with) as an opaque block of qv_instance_snapshot_size() bytes, for rewinding,
    replays and save games: restoring a snapshot and repeating the same calls repeats the same bits.
    Restoring checks the size, that the snapshot came from a model of the same r, that its values
-   are finite and that its damping stiffness is positive definite (QV_ERROR_INVALID_ARGUMENT
+   are finite (but for the last step's forces, where a step that reset may leave one that is not)
+   and that its damping stiffness is positive definite (QV_ERROR_INVALID_ARGUMENT
    otherwise, the instance unchanged). Restoring also restores whether a persistent load had changed since that step, so
    set loads after restoring, as the calls being repeated would. Saving uses the instance's scratch
    (QV_SOLVER_NEWTON: it evaluates the state), so save one instance from one thread at a time. */

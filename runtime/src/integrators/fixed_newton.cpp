@@ -16,18 +16,27 @@ constexpr int kExactEndChecks = 60;
 
 // Settles the account with E(q) (s.elasticEnergyAtState) at this step's loads: a shortfall is slack;
 // an excess beyond rounding is taken out as the minimiser's budget takes it out (holdToBudget()),
-// with the previous step's start in the role of the start. Returns whether q moved.
-bool settleEnergyAccount(qv_instance& s) {
+// with the previous step's start in the role of the start, or, where the loads changed since (its
+// potential under them says nothing of the budget), from the velocity alone. Returns whether q
+// moved (then, as where the minimiser's step is held back, with no acceleration).
+bool settleEnergyAccount(qv_instance& s, bool loadsChanged) {
+  double kinetic = 0;
+  for (int i = 0; i < s.r; ++i) kinetic += 0.5 * s.v[i] * s.v[i];
   const double excess = s.elasticEnergyAtState - s.elasticAllowance;
-  if (!(excess > 1e-12 * (std::fabs(s.elasticEnergyAtState) + std::fabs(s.elasticAllowance)))) {
+  const double roundoff = 1e-12 * (std::fabs(s.elasticEnergyAtState) + std::fabs(s.elasticAllowance) + kinetic);
+  if (!(excess > roundoff)) {
     s.energySlack = std::fmax(-excess, 0.0);
     return false;
   }
   s.energySlack = 0;
   s.exactEndChecks = kExactEndChecks;
   const double budget = stepEnergy(s, s.q, s.v, s.elasticEnergyAtState) - excess;
-  holdToBudget(s, budget, s.previousQ, s.previousElastic, s.q, s.v, s.elasticEnergyAtState, s.lastStep);
-  return s.lastStep.held_back != 0;
+  // From q itself the position holds no more than the start: only the velocity gives.
+  const double* start = loadsChanged ? s.q : s.previousQ;
+  const double startElastic = loadsChanged ? s.elasticEnergyAtState : s.previousElastic;
+  if (!holdToBudget(s, budget, start, startElastic, s.q, s.v, s.elasticEnergyAtState, s.lastStep)) return false;
+  std::memset(s.a, 0, sizeof(double) * s.r);
+  return true;
 }
 
 } // namespace
@@ -35,12 +44,13 @@ bool settleEnergyAccount(qv_instance& s) {
 const double* beginFixedNewton(qv_instance& s, double& budget) {
   elasticityAt(s, s.q, &s.elasticEnergyAtState, s.work.force);
   const double* J = s.loads.addStateForces(s.q, s.work.force);
-  if (settleEnergyAccount(s)) {  // drawn back: the step starts from there
+  const bool loadsChanged = s.loads.changedSinceLastStep();  // read once: it clears the flag
+  if (settleEnergyAccount(s, loadsChanged)) {  // drawn back: the step starts from there
     elasticityAt(s, s.q, &s.elasticEnergyAtState, s.work.force);
     J = s.loads.addStateForces(s.q, s.work.force);
   }
   // As the minimiser's (MinimizeTask::begin()): what was lost under other loads is not owed.
-  if (s.loads.changedSinceLastStep()) s.energySlack = 0;
+  if (loadsChanged) s.energySlack = 0;
   budget = stepEnergy(s, s.q, s.v, s.elasticEnergyAtState) + s.energySlack;
   return J;
 }
@@ -72,7 +82,8 @@ qv_step_status endFixedNewton(qv_instance& s, double budget, StepFunction minimi
   if (s.exactEndChecks > 0) {
     --s.exactEndChecks;
     double elastic = elasticEnergy(*s.model, s.config.elasticity, s.end.q, s.work.polynomialScratch);
-    holdToBudget(s, budget, s.q, s.elasticEnergyAtState, s.end.q, s.end.v, elastic, s.lastStep);
+    if (holdToBudget(s, budget, s.q, s.elasticEnergyAtState, s.end.q, s.end.v, elastic, s.lastStep))
+      std::memset(s.end.a, 0, sizeof(double) * r);
   }
   s.elasticAllowance = budget - stepEnergy(s, s.end.q, s.end.v, 0.0);
   std::memcpy(s.previousQ, s.q, sizeof(double) * r);

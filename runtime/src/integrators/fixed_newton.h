@@ -18,8 +18,8 @@
 // overshoots it tends to again, so after an excess the next 60 steps evaluate E at their ends and
 // hold them to the budget at once (holdToBudget() from the step's start), at one more evaluation
 // each. (An undamped sliver beam released from a 180-degree twist at one iteration: 5 of 480 steps
-// ended above its energy at the release, the first at 2800 times it; before, 84% did, up to 7e9
-// times, and it ran away.)
+// ended above its energy at the release, the highest at 8.2 times it; in runtime 0.11, 84% did, at
+// a median of 33 times it, and it ran away.)
 #include "integrator.h"
 
 namespace quiver::rt {

@@ -99,10 +99,15 @@ double stepEnergy(const qv_instance& s, const double* q, const double* v, double
   return kinetic + elastic + S - external;
 }
 
-void holdToBudget(qv_instance& s, double budget, const double* start, double startElastic, double* x, double* velocity,
+bool holdToBudget(qv_instance& s, double budget, const double* start, double startElastic, double* x, double* velocity,
                   double& elastic, qv_step_report& report) {
   const int r = s.r;
-  if (stepEnergy(s, x, nullptr, elastic) > budget) {
+  // Never less than the start holds: where damping's share (counted from the velocity before the
+  // hold) or other loads put the start outside, the bisection would end there, frozen.
+  const double startPotential = stepEnergy(s, start, nullptr, startElastic);
+  const bool drawBack = stepEnergy(s, x, nullptr, elastic) > std::fmax(budget, startPotential);
+  if (drawBack) {
+    budget = std::fmax(budget, startPotential);
     // Bisection on x(t) = start + t (x - start) for the farthest t whose potential is within the budget
     // (t = 0, the start, is); 12 halvings leave t within 1/4096 of it.
     double* farEnd = s.work.segmentEnd;
@@ -128,8 +133,9 @@ void holdToBudget(qv_instance& s, double budget, const double* start, double sta
     const double kinetic = 0.5 * dot(velocity, velocity, r), potential = energyAfter - kinetic;
     const double keep = potential < budget && kinetic > 0 ? std::sqrt((budget - potential) / kinetic) : 0.0;
     for (int i = 0; i < r; ++i) velocity[i] *= keep;
-    report.energy_removed = kinetic * (1 - keep * keep);
+    report.energy_removed += kinetic * (1 - keep * keep);
   }
+  return drawBack;
 }
 
 double dampingShare(qv_instance& s, const double* K) {

@@ -90,9 +90,11 @@ private:
 double stepEnergy(const qv_instance& s, const double* q, const double* v, double elastic);
 
 // The budget holds: never end a step with more. Where the position x alone holds more, draw it back
-// toward `start` (E = startElastic), whose potential is within the budget, and say so
-// (report.held_back); the velocity then gets what is left (report.energy_removed). `elastic`: E(x), in and out.
-void holdToBudget(qv_instance& s, double budget, const double* start, double startElastic, double* x, double* velocity,
+// toward `start` (E = startElastic), whose potential is within the budget (or is the budget where
+// it holds more), and say so
+// (report.held_back, and the return value); the velocity then gets what is left
+// (report.energy_removed). `elastic`: E(x), in and out.
+bool holdToBudget(qv_instance& s, double budget, const double* start, double startElastic, double* x, double* velocity,
                   double& elastic, qv_step_report& report);
 
 // What damping dissipates over the step from s.v to s.end.v: h v_mid^T C v_mid, C = alpha I + beta K
