@@ -154,8 +154,8 @@ class RobustStep(unittest.TestCase):
 
     def test_fixed_newton_energy_stays_within_the_release_but_for_single_steps(self):
         """The fixed Newton step (one iteration) holds the same budget one step late: a step may end
-        above it until the next starts, and after such an excess the next 60 steps are held at once
-        (runtime/src/integrators/fixed_newton.h). Measured: 5 of 480 step ends above the release's
+        above it until the next starts, and after a step's end is drawn back the next 60 are held at
+        once (runtime/src/integrators/fixed_newton.h). Measured: 6 of 480 step ends above the release's
         energy on the jittered beam, none on bar-2523, and both end below it; runtime 0.11 ended 84%
         and 99% of them above, with a median of 33 and 9e6 times the release energy."""
         if not self.models:

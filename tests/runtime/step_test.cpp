@@ -298,23 +298,37 @@ TEST(Step, AFixedNewtonInstanceRestoredFromItsSnapshotRepeatsItsStepsBitForBit) 
       removed += report.energy_removed;
     }
   };
-  Instance a(m.model, config), b(m.model, config);
-  qv_instance_set_gravity(a.s, g);
-  qv_instance_set_gravity(b.s, g);
-  // Saved a step after the push flipped and the budget drew the state back (step 631): the account
-  // then carries slack and exact end checks into the steps repeated.
-  run(a.s, 0, 632);
-  std::vector<char> snapshot(qv_instance_snapshot_size(a.s));
-  qv_instance_save_snapshot(a.s, snapshot.data());
-  removed = 0;
-  run(a.s, 632, 1200);
-  EXPECT_GT(removed, 0.0) << "the budget must act while the steps are repeated";
-  ASSERT_EQ(qv_instance_restore_snapshot(b.s, snapshot.data(), snapshot.size()), QV_OK);
-  run(b.s, 632, 1200);
-  std::vector<double> sa(3 * r), sb(3 * r);
-  qv_instance_get_state(a.s, sa.data(), sa.data() + r, sa.data() + 2 * r);
-  qv_instance_get_state(b.s, sb.data(), sb.data() + r, sb.data() + 2 * r);
-  EXPECT_EQ(0, std::memcmp(sa.data(), sb.data(), sizeof(double) * sa.size()));
+  // Saved two steps after a flip of the push, and while the account holds exact end checks (the push
+  // flipped at 690, and the next step drew the state back).
+  for (const int saved : {632, 700}) {
+    Instance a(m.model, config), b(m.model, config);
+    qv_instance_set_gravity(a.s, g);
+    qv_instance_set_gravity(b.s, g);
+    run(a.s, 0, saved);
+    if (saved == 700) {
+      ASSERT_GT(a.s->exactEndChecks, 0);
+    }
+    std::vector<char> snapshot(qv_instance_snapshot_size(a.s));
+    qv_instance_save_snapshot(a.s, snapshot.data());
+    // The account itself, which the steps below read only where the budget binds before the loads
+    // change again.
+    const double allowance = a.s->elasticAllowance, previousElastic = a.s->previousElastic;
+    const std::vector<double> previousQ(a.s->previousQ, a.s->previousQ + r);
+    const int checks = a.s->exactEndChecks;
+    removed = 0;
+    run(a.s, saved, 1200);
+    EXPECT_GT(removed, 0.0) << "the budget must act while the steps are repeated";
+    ASSERT_EQ(qv_instance_restore_snapshot(b.s, snapshot.data(), snapshot.size()), QV_OK);
+    EXPECT_EQ(b.s->elasticAllowance, allowance);
+    EXPECT_EQ(b.s->previousElastic, previousElastic);
+    EXPECT_EQ(std::vector<double>(b.s->previousQ, b.s->previousQ + r), previousQ);
+    EXPECT_EQ(b.s->exactEndChecks, checks);
+    run(b.s, saved, 1200);
+    std::vector<double> sa(3 * r), sb(3 * r);
+    qv_instance_get_state(a.s, sa.data(), sa.data() + r, sa.data() + 2 * r);
+    qv_instance_get_state(b.s, sb.data(), sb.data() + r, sb.data() + 2 * r);
+    EXPECT_EQ(0, std::memcmp(sa.data(), sb.data(), sizeof(double) * sa.size())) << "saved at step " << saved;
+  }
 }
 
 TEST(Step, DeterministicAndStateRoundTrips) {

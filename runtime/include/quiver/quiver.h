@@ -165,9 +165,9 @@ typedef enum qv_solver {
                              with beyond it is taken out at the next step's start (E at the end is evaluated there
                              anyway), from the velocity or, where the position alone holds more, by drawing the state
                              back toward the last step's start; so a state handed out may hold more than its budget
-                             for one step, after which the next 60 steps are held to it at their ends at one more
-                             evaluation each (released undamped from a 180-degree twist at one iteration, a sliver
-                             beam's energy exceeded that at the release at 5 of 480 step ends, at most 8.2 times
+                             for one step, and after a draw-back the next 60 steps are held to it at their ends at
+                             one more evaluation each (released undamped from a 180-degree twist at one iteration, a sliver
+                             beam's energy exceeded that at the release at 6 of 480 step ends, at most 8.2 times
                              it; 84% of them, and a runaway, in runtime 0.11). Where strains are large (stiff
                              springs, large twists, long time steps, sudden loads and releases) the iterations can
                              diverge: a step whose system is not positive definite, or whose end may move a vertex
@@ -255,10 +255,10 @@ typedef struct qv_step_report {
   double gradient;         /* QV_SOLVER_MINIMIZE: |gradient| / force scale at the end */
   int held_back;           /* 1 when the end position alone held more energy than the step may end with, so it was
                               drawn back toward the start (the velocity keeps what is left); QV_SOLVER_NEWTON: the
-                              last step's end, at this step's start, or, after an excess, this step's end */
+                              last step's end, at this step's start, or, after such a draw-back, this step's end */
   double energy_removed;   /* kinetic energy (J) the step took out so as not to add energy (QV_SOLVER_NEWTON: at its
-                              start, of what the step before ended with beyond its budget, and, after such an
-                              excess, at its end) */
+                              start, of what the step before ended with beyond its budget, and, after a draw-back
+                              (held_back), at its end) */
   int minimized;           /* QV_SOLVER_NEWTON: 1 when the minimising solver took the step (the Newton system was not
                               positive definite, the step may have moved a vertex past max_displacement, or, under
                               implicit Newmark, soft contacts were in its solve); the fields above then describe its step */

@@ -10,8 +10,8 @@ namespace quiver::rt {
 
 namespace {
 
-// After a step found more energy than its budget, this many steps hold their ends to it at once,
-// at one more evaluation each: where one iteration overshoots, it tends to again.
+// After a step's end was drawn back toward its start, this many steps hold their ends to the budget
+// at once, at one more evaluation each: where one iteration overshoots that far, it tends to again.
 constexpr int kExactEndChecks = 60;
 
 // Settles the account with E(q) (s.elasticEnergyAtState) at this step's loads: a shortfall is slack;
@@ -29,13 +29,13 @@ bool settleEnergyAccount(qv_instance& s, bool loadsChanged) {
     return false;
   }
   s.energySlack = 0;
-  s.exactEndChecks = kExactEndChecks;
   const double budget = stepEnergy(s, s.q, s.v, s.elasticEnergyAtState) - excess;
   // From q itself the position holds no more than the start: only the velocity gives.
   const double* start = loadsChanged ? s.q : s.previousQ;
   const double startElastic = loadsChanged ? s.elasticEnergyAtState : s.previousElastic;
   if (!holdToBudget(s, budget, start, startElastic, s.q, s.v, s.elasticEnergyAtState, s.lastStep)) return false;
   std::memset(s.a, 0, sizeof(double) * s.r);
+  s.exactEndChecks = kExactEndChecks;
   return true;
 }
 
