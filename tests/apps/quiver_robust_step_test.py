@@ -131,17 +131,21 @@ class RobustStep(unittest.TestCase):
                     self.assertEqual(newton["resets"], 0)
                     self.assertTrue(all(np.isfinite(float(r["elastic_J"])) for r in rows))
 
+    def twist_and_release(self, model, length, integrator, *args):
+        """Twisted 180 degrees by stiff springs for 1 s at 120 Hz, then let go for 4 s, undamped: the
+        run's JSON, the kinetic + elastic energy the springs let go of, and that of each step after."""
+        j, rows = self.sim(model, length, "--hold", 120, "--steps", 600, "--dt", 1 / 120, "--stiffness", 1e5,
+                           "--twist", 180, "--alpha", 0, "--beta", 0, "--integrator", integrator, *args)
+        energy = np.array([float(r["kinetic_J"]) + float(r["elastic_J"]) for r in rows])
+        return j, energy[119], energy[120:]
+
     def test_energy_never_grows_after_release_without_damping(self):
         if not self.models:
             self.skipTest("no mesh to test")
         for name, (model, L, _) in self.models.items():
             for integrator in ("newmark", "euler"):
                 with self.subTest(mesh=name, integrator=integrator):
-                    _, rows = self.sim(model, L, "--hold", 120, "--steps", 600, "--dt", 1 / 120, "--stiffness", 1e5,
-                                       "--twist", 180, "--alpha", 0, "--beta", 0, "--integrator", integrator)
-                    energy = np.array([float(r["kinetic_J"]) + float(r["elastic_J"]) for r in rows])
-                    released = energy[119]  # the state the springs let go of
-                    after = energy[120:]
+                    _, released, after = self.twist_and_release(model, L, integrator)
                     print(f"{name}, {integrator}: energy at release {released:.4g} J, then {after.min():.4g} .. "
                           f"{after.max():.4g} J, drift over {len(after)} steps {(after[-1] - released) / released:+.2%}")
                     self.assertGreater(released, 0)
@@ -150,7 +154,6 @@ class RobustStep(unittest.TestCase):
                     # rule trades with the budget swings widely and the phase at any one step differs between bakes.
                     # That the budget keeps energy (wipes no velocity) is Step.UndampedNewmarkKeepsEnergyBounded...'s
                     # lower bound, on a model of its own.
-
 
     def test_fixed_newton_energy_stays_within_the_release_but_for_single_steps(self):
         """The fixed Newton step (one iteration) holds the same budget one step late: a step may end
@@ -163,11 +166,7 @@ class RobustStep(unittest.TestCase):
         for name, (model, L, _) in self.models.items():
             for integrator in ("newmark", "euler"):
                 with self.subTest(mesh=name, integrator=integrator):
-                    j, rows = self.sim(model, L, "--hold", 120, "--steps", 600, "--dt", 1 / 120, "--stiffness", 1e5,
-                                       "--twist", 180, "--alpha", 0, "--beta", 0, "--integrator", integrator,
-                                       "--solver", "newton", "--newton", 1)
-                    energy = np.array([float(r["kinetic_J"]) + float(r["elastic_J"]) for r in rows])
-                    released, after = energy[119], energy[120:]
+                    j, released, after = self.twist_and_release(model, L, integrator, "--solver", "newton", "--newton", 1)
                     above = np.mean(after > released * 1.01)
                     print(f"{name}, {integrator}, fixed Newton: energy at release {released:.4g} J, {above:.1%} of the "
                           f"steps after it end above, median {np.median(after) / released:.3g} of it, last "
@@ -176,6 +175,7 @@ class RobustStep(unittest.TestCase):
                     self.assertLess(above, 0.03)
                     self.assertLess(np.median(after), released)
                     self.assertLess(after[-1], released * 1.01)
+
 
 class SpreadSpectrum(unittest.TestCase):
     @classmethod
