@@ -162,8 +162,7 @@ struct qv_instance {
   // orientation, velocity, angular momentum, last body omega), then D's upper triangle row by row,
   // then the last step's per-step forces and whether a persistent load changed since (1 or 0), then
   // the fixed Newton account (the elastic allowance, the previous E(q) and q, the exact end checks
-  // left), as doubles: all a
-  // step reads beyond the caller's calls.
+  // left), as doubles: all a step reads beyond the caller's calls.
   size_t snapshotSize() const {
     const size_t n = static_cast<size_t>(r);
     return sizeof(double) * (3 * n + 3 + (flying() ? 16 : 0) + n * (n + 1) / 2 + 2 * n + 4);

@@ -32,7 +32,7 @@ void fallAsleep(qv_instance& s, int group) {
   std::memset(s.a, 0, sizeof(double) * s.r);
   s.energySlack = 0;
   // A fixed Newton step's account too (integrators/fixed_newton.h): none left to make up.
-  if (!s.minimizes()) s.openEnergyAccount(elasticEnergy(*s.model, s.config.elasticity, s.q, s.work.polynomialScratch));
+  if (s.keepsEnergyAccount()) s.openEnergyAccount(elasticEnergy(*s.model, s.config.elasticity, s.q, s.work.polynomialScratch));
   RigidFrame& f = s.frame;
   std::memset(f.velocity, 0, sizeof f.velocity);
   std::memset(f.angularMomentum, 0, sizeof f.angularMomentum);

@@ -103,9 +103,15 @@ bool holdToBudget(qv_instance& s, double budget, const double* start, double sta
                   double& elastic, qv_step_report& report) {
   const int r = s.r;
   // Never less than the start holds: where damping's share (counted from the velocity before the
-  // hold) or other loads put the start outside, the bisection would end there, frozen.
-  const double startPotential = stepEnergy(s, start, nullptr, startElastic);
-  const bool drawBack = stepEnergy(s, x, nullptr, elastic) > std::fmax(budget, startPotential);
+  // hold) or other loads put the start outside, the bisection would end there, frozen. (Its
+  // potential is needed only past the budget: most steps end within it.)
+  const double endPotential = stepEnergy(s, x, nullptr, elastic);
+  double startPotential = 0;
+  bool drawBack = false;
+  if (endPotential > budget) {
+    startPotential = stepEnergy(s, start, nullptr, startElastic);
+    drawBack = endPotential > startPotential;
+  }
   if (drawBack) {
     budget = std::fmax(budget, startPotential);
     // Bisection on x(t) = start + t (x - start) for the farthest t whose potential is within the budget
