@@ -158,23 +158,27 @@ class RobustStep(unittest.TestCase):
     def test_fixed_newton_energy_stays_within_the_release_but_for_single_steps(self):
         """The fixed Newton step (one iteration) holds the same budget one step late: a step may end
         above it until the next starts, and after a step's end is drawn back the next 60 are held at
-        once (runtime/src/integrators/fixed_newton.h). Measured: 6 of 480 step ends above the release's
-        energy on the jittered beam, none on bar-2523, and both end below it; runtime 0.11 ended 84%
-        and 99% of them above, with a median of 33 and 9e6 times the release energy."""
+        once (runtime/src/integrators/fixed_newton.h). Measured: 6-7 of 480 step ends above the release's
+        energy on the jittered beam, never two in a row, none on bar-2523; runtime 0.11 ended 84% and
+        99% of them above, with a median of 33 and 9e6 times the release energy. (Which steps end above
+        depends on the last bits: the beam's last step did in one build, 2.0 times the release.)"""
         if not self.models:
             self.skipTest("no mesh to test")
         for name, (model, L, _) in self.models.items():
             for integrator in ("newmark", "euler"):
                 with self.subTest(mesh=name, integrator=integrator):
                     j, released, after = self.twist_and_release(model, L, integrator, "--solver", "newton", "--newton", 1)
-                    above = np.mean(after > released * 1.01)
-                    print(f"{name}, {integrator}, fixed Newton: energy at release {released:.4g} J, {above:.1%} of the "
-                          f"steps after it end above, median {np.median(after) / released:.3g} of it, last "
-                          f"{after[-1] / released:.3g}; {j['held_back_steps']} drawn back")
+                    high = after > released * 1.01
+                    in_a_row = int(np.sum(high[1:] & high[:-1]))
+                    print(f"{name}, {integrator}, fixed Newton: energy at release {released:.4g} J, {np.mean(high):.1%} "
+                          f"of the steps after it end above ({in_a_row} right after another), median "
+                          f"{np.median(after) / released:.3g} of it, over the last second "
+                          f"{np.median(after[-120:]) / released:.3g}; {j['held_back_steps']} drawn back")
                     self.assertEqual(j["resets"], 0)
-                    self.assertLess(above, 0.03)
+                    self.assertLess(np.mean(high), 0.03)
+                    self.assertEqual(in_a_row, 0)
                     self.assertLess(np.median(after), released)
-                    self.assertLess(after[-1], released * 1.01)
+                    self.assertLess(np.median(after[-120:]), released)
 
 
 class SpreadSpectrum(unittest.TestCase):
