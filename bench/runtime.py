@@ -71,16 +71,17 @@ def main():
     peak_gflops = peak["GFLOPS"] / 1e9 if peak else float("nan")
     print(machine_line())
     print(f"Peak FMA throughput of this core, measured in the same run: {peak_gflops:.1f} GFLOP/s (double, its widest vectors)\n")
-    print("| r | force (us) | force + stiffness (us) | Newmark step, fixed Newton (us) | its steps the minimiser took "
+    print("| r | force (us) | force + stiffness (us) | energy alone (us) | Newmark step, fixed Newton (us) "
+          "| its steps the minimiser took "
           "| Vega-like step, same run (us) | x Vega | Newmark step, minimise (us) | its Newton iterations "
           "| evaluation GFLOP/s | fraction of peak |")
-    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for r in RANKS:
-        f, fk = get(f"Evaluate/force/r{r}"), get(f"Evaluate/force+stiffness/r{r}")
+        f, fk, energy = get(f"Evaluate/force/r{r}"), get(f"Evaluate/force+stiffness/r{r}"), get(f"Evaluate/energy/r{r}")
         newton, minimize = get(f"Step/newton/r{r}"), get(f"Step/minimize/r{r}")
         gflops = fk["GFLOPS"] / 1e9
         reference = vega.get(r, float("nan"))
-        print(f"| {r} | {f['real_time']:.2f} | {fk['real_time']:.2f} | {newton['real_time']:.2f} | "
+        print(f"| {r} | {f['real_time']:.2f} | {fk['real_time']:.2f} | {energy['real_time']:.2f} | {newton['real_time']:.2f} | "
               f"{newton['minimized']:.2%} | {reference:.1f} | "
               f"{reference / newton['real_time']:.1f} | {minimize['real_time']:.2f} | {minimize['newton_per_step']:.2f} | {gflops:.1f} | {gflops / peak_gflops:.0%} |")
     print("\nCoefficient precision and the memory floor (force + stiffness; *stream* reads the same bytes as "

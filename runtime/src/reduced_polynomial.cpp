@@ -125,9 +125,62 @@ QV_HOT void blockedProduct(const double* B, int r, size_t rows, const double* q,
   }
 }
 
+// The energy's monomials (ReducedPolynomial::monomials_) come in runs, each against a tail of the
+// pair products x (pairs in row order, then kRun zeros): padded to whole runs of kRun doubles, a
+// run is swept by four independent vectors of four with no tail loop (one vector alone would wait
+// on the multiply-add latency).
+constexpr size_t kRun = 16;
+size_t wholeRuns(size_t length) { return (length + kRun - 1) / kRun * kRun; }
+// The pairs (k, l), k <= l, from pair (j, j) to the last: the monomials that complete a run whose
+// indices so far end with j.
+size_t tailFrom(int r, int j) { return monomialCount2(r - j); }
+size_t monomialsCount(int r) {
+  size_t count = wholeRuns(monomialCount2(r));
+  for (int i = 0; i < r; ++i) count += wholeRuns(tailFrom(r, i));
+  for (int i = 0; i < r; ++i)
+    for (int j = i; j < r; ++j) count += wholeRuns(tailFrom(r, j));
+  return count;
+}
+
+// sum += w sum_s c[s] x[s] over a run padded to whole kRun, as a vector summed once at the end (by
+// reference: returned, a vector's ABI depends on the clone).
+using V4 = Vector<double, 4>::type;
+[[gnu::always_inline]] inline void addRun(const double* c, const double* x, size_t length, double w, V4& sum) {
+  V4 s[4] = {};
+  for (size_t i = 0; i < length; i += kRun)
+    for (int v = 0; v < 4; ++v) {
+      V4 cv, xv;
+      std::memcpy(&cv, c + i + 4 * v, sizeof cv);
+      std::memcpy(&xv, x + i + 4 * v, sizeof xv);
+      s[v] += cv * xv;
+    }
+  sum += w * ((s[0] + s[1]) + (s[2] + s[3]));
+}
+
+// E(q) = sum c2 x + sum_i q_i (c3 run i . x tail) + sum_{i<=j} x_ij (c4 run ij . x tail), with
+// x_kl = q_k q_l for the pairs in row order (P of them, kRun zeros after).
+QV_HOT double monomialEnergy(const double* c, int r, const double* q, const double* x) {
+  const size_t P = monomialCount2(r);
+  V4 sum = {};
+  addRun(c, x, P, 1.0, sum);
+  c += wholeRuns(P);
+  for (int i = 0; i < r; ++i) {
+    const size_t length = tailFrom(r, i);
+    addRun(c, x + (P - length), length, q[i], sum);
+    c += wholeRuns(length);
+  }
+  for (int i = 0, p = 0; i < r; ++i)
+    for (int j = i; j < r; ++j, ++p) {
+      const size_t length = tailFrom(r, j);
+      addRun(c, x + (P - length), length, x[p], sum);
+      c += wholeRuns(length);
+    }
+  return (sum[0] + sum[1]) + (sum[2] + sum[3]);
+}
+
 } // namespace
 
-ReducedPolynomial::Arrays ReducedPolynomial::carve(BlockCarver& c, bool single, bool groups) const {
+ReducedPolynomial::Arrays ReducedPolynomial::carve(BlockCarver& c, bool single, bool monomials, bool groups) const {
   Arrays a{};
   a.k2 = c.take<double>(pairs_);
   a.t = c.take<double>(static_cast<size_t>(r_) * blockedRows(pairs_));
@@ -135,6 +188,7 @@ ReducedPolynomial::Arrays ReducedPolynomial::carve(BlockCarver& c, bool single, 
     a.q32 = c.take<float>(packedCount(blockedRows(pairs_)));
   else
     a.q64 = c.take<double>(packedCount(blockedRows(pairs_)));
+  if (monomials) a.monomials = c.take<double>(monomialsCount(r_));
   if (!groups) return a;
   const size_t d = static_cast<size_t>(r_) * blockedRows(triples_);
   if (single)
@@ -145,21 +199,23 @@ ReducedPolynomial::Arrays ReducedPolynomial::carve(BlockCarver& c, bool single, 
   return a;
 }
 
-size_t ReducedPolynomial::measure(int r, bool single, bool groups) {
+size_t ReducedPolynomial::measure(int r, bool single, bool monomials, bool groups) {
   ReducedPolynomial measured;
   measured.r_ = r;
   measured.pairs_ = monomialCount2(r);
   measured.triples_ = monomialCount3(r);
   BlockCarver c(nullptr);
-  measured.carve(c, single, groups);
+  measured.carve(c, single, monomials, groups);
   return c.size();
 }
 
-size_t ReducedPolynomial::storageBytes(int r, bool single, bool groups) { return measure(r, single, groups); }
+size_t ReducedPolynomial::storageBytes(int r, bool single, bool groups) { return measure(r, single, true, groups); }
 
-size_t ReducedPolynomial::evaluationBytes(int r, bool single) { return measure(r, single, false); }
+size_t ReducedPolynomial::evaluationBytes(int r, bool single) { return measure(r, single, false, false); }
 
 size_t ReducedPolynomial::scratchSize(int r) {
+  // evaluate()'s three arrays of blockedRows(P) >= 8 doubles, and r; the monomials' P pair products
+  // and kRun zeros fit in them.
   return blockedRows(monomialCount2(r)) * 3 + static_cast<size_t>(r);
 }
 
@@ -169,7 +225,7 @@ void ReducedPolynomial::build(int r, const double* c, bool single, bool groups, 
   triples_ = monomialCount3(r);
   const size_t P = pairs_;
   BlockCarver carver(static_cast<char*>(storage));
-  const Arrays arrays = carve(carver, single, groups);
+  const Arrays arrays = carve(carver, single, true, groups);
   std::memset(storage, 0, carver.size());
   double* k2 = arrays.k2;
   double* t = arrays.t;
@@ -229,6 +285,29 @@ void ReducedPolynomial::build(int r, const double* c, bool single, bool groups, 
               arrays.d64[at] = value / 2;
           }
         }
+  // The monomials' runs, in the file's order (sorted tuples in lexicographic order, so a run is the
+  // file's coefficients for its leading index or pair), each padded to whole kRun. The quartic's as
+  // the stored layout rounds them: float32 holds the tensor entries, the coefficients times
+  // repeatFactor().
+  double* to = arrays.monomials;
+  std::memcpy(to, c2, sizeof(double) * P);
+  to += wholeRuns(P);
+  for (int i = 0; i < r; ++i) {
+    std::memcpy(to, c3 + monomialIndex3(r, i, i, i), sizeof(double) * tailFrom(r, i));
+    to += wholeRuns(tailFrom(r, i));
+  }
+  for (int i = 0; i < r; ++i)
+    for (int j = i; j < r; ++j) {
+      size_t s = 0;
+      for (int k = j; k < r; ++k)
+        for (int l = k; l < r; ++l, ++s) {
+          const double value = c4[monomialIndex4(r, i, j, k, l)];
+          const int idx[4] = {i, j, k, l};
+          const double f = repeatFactor(idx);
+          to[s] = single ? static_cast<double>(static_cast<float>(value * f)) / f : value;
+        }
+      to += wholeRuns(s);
+    }
   for (int a = 0, p = 0; groups && a < r; ++a)
     for (int b = a; b < r; ++b, ++p)
       for (int k = 0; k < r; ++k) {
@@ -240,12 +319,17 @@ void ReducedPolynomial::build(int r, const double* c, bool single, bool groups, 
   d64_ = arrays.d64;
   d32_ = arrays.d32;
   tripleOf_ = arrays.tripleOf;
+  monomials_ = arrays.monomials;
   q64_ = arrays.q64;
   q32_ = arrays.q32;
 }
 
 void ReducedPolynomial::evaluate(const double* q, double* energy, double* force, double* stiffness,
                                  double* scratch) const {
+  if (!force && !stiffness) {
+    if (energy) *energy = energyFromMonomials(q, scratch);
+    return;
+  }
   const int r = r_;
   const size_t P = pairs_;
   const size_t n = blockedRows(P);
@@ -277,6 +361,16 @@ void ReducedPolynomial::evaluate(const double* q, double* energy, double* force,
   if (force)
     for (int i = 0; i < r; ++i) force[i] = Rq[i];
   if (energy) *energy = e;
+}
+
+double ReducedPolynomial::energyFromMonomials(const double* q, double* scratch) const {
+  const int r = r_;
+  double* x = scratch;  // q_k q_l, pairs in row order, then kRun zeros for the runs' padding
+  size_t s = 0;
+  for (int k = 0; k < r; ++k)
+    for (int l = k; l < r; ++l) x[s++] = q[k] * q[l];
+  for (size_t z = 0; z < kRun; ++z) x[s++] = 0;
+  return monomialEnergy(monomials_, r, q, x);
 }
 
 } // namespace quiver::rt

@@ -1,6 +1,7 @@
 // The reduced polynomial's two layouts (one state's packed symmetric product, the groups' two-pass
-// contraction) against the energy differentiated monomial by monomial, for bases small enough to
-// leave blocks of eight partly filled or to have a single pair.
+// contraction) and its energy alone (summed from the monomials) against the energy differentiated
+// monomial by monomial, for bases small enough to leave blocks of eight partly filled or to have a
+// single pair.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -74,7 +75,7 @@ double largest(const std::vector<double>& x) {
 } // namespace
 
 // float32 coefficients: within 1e-6 of the exact values (the coefficients' rounding, summed), and
-// the two layouts within 1e-13 of each other (the same rounded coefficients).
+// the two layouts and the energy alone within 1e-13 of each other (the same rounded coefficients).
 TEST(ReducedPolynomial, BothLayoutsAgreeWithTheEnergyDifferentiatedTermByTerm) {
   std::mt19937 rng(7);
   std::normal_distribution<double> n(0, 1);
@@ -110,6 +111,10 @@ TEST(ReducedPolynomial, BothLayoutsAgreeWithTheEnergyDifferentiatedTermByTerm) {
                                   ", lane " + std::to_string(l);
         EXPECT_NEAR(e1, exact.energy, tolerance) << where;
         EXPECT_NEAR(energy[l], e1, agree) << where;
+        double alone = 0;  // summed from the monomials: the same rounded coefficients
+        poly.evaluate(q[l].data(), &alone, nullptr, nullptr, oneScratch.data());
+        EXPECT_NEAR(alone, exact.energy, tolerance) << where;
+        EXPECT_NEAR(alone, e1, agree) << where;
         for (int a = 0, p = 0; a < r; ++a) {
           EXPECT_NEAR(f1[a], exact.gradient[a], tolerance) << where << ", a = " << a;
           EXPECT_NEAR(f[l][a], f1[a], agree) << where << ", a = " << a;

@@ -79,13 +79,14 @@ typedef struct qv_model_info {
 
 /* How a model is held in memory. Fill with qv_model_config_init(). */
 typedef struct qv_model_config {
-  int coefficient_precision; /* 64 (default): the baked coefficients exactly; 32: half the memory,
-                                force and stiffness within about 1e-7 relative (bench/README.md) */
+  int coefficient_precision; /* 64 (default): the baked coefficients exactly; 32: the packed quartic
+                                in float32 (0.97 MB instead of 1.43 at r = 30), force and stiffness
+                                within about 1e-7 relative (bench/README.md) */
   int group_layout;          /* 1: also lay the quartic coefficients out for qv_instances_step's groups
-                                of 8 (crowds step about 20% faster; 2.3 times the coefficients'
-                                memory: 2.3 MB instead of 1.0 at r = 30 in float64, 33 MB instead of
-                                14 at r = 60); 0: not, and qv_instances_step steps this model's
-                                instances one by one; -1 (default): 1 up to r = 64, else 0 */
+                                of 8 (crowds step about 20% faster; 2.67 MB instead of 1.43 at r = 30
+                                in float64, 38 MB instead of 20 at r = 60); 0: not, and
+                                qv_instances_step steps this model's instances one by one; -1
+                                (default): 1 up to r = 64, else 0 */
 } qv_model_config;
 QV_API void qv_model_config_init(qv_model_config* config);
 
