@@ -52,12 +52,11 @@ const double* Loads::addStateForces(const double* q, double* force, double* ener
 void Loads::endStep() {
   std::memcpy(lastStepForce, stepForce, sizeof(double) * r);
   std::memset(stepForce, 0, sizeof(double) * r);
+  changed = false;
 }
 
-bool Loads::changedSinceLastStep() {
-  const bool was = changed || std::memcmp(stepForce, lastStepForce, sizeof(double) * r) != 0;
-  changed = false;
-  return was;
+bool Loads::changedSinceLastStep() const {
+  return changed || std::memcmp(stepForce, lastStepForce, sizeof(double) * r) != 0;
 }
 
 void Loads::addVertexForce(const qv_model& m, qv_elasticity elasticity, const double* q, int vertex,

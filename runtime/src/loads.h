@@ -47,10 +47,11 @@ struct Loads {
   // `energy`, when not null, receives the state forces' potential at q (the minimising solver needs
   // it: every state force it steps with must have one, up to a constant).
   const double* addStateForces(const double* q, double* force, double* energy = nullptr) const;
-  void endStep();  // the per-step forces are spent
+  void endStep();  // the per-step forces are spent, and the persistent ones are the last step's
   // Whether this step's loads differ from the last step's (a per-step force applied again unchanged
-  // is no change); clears the record.
-  bool changedSinceLastStep();
+  // is no change): the same answer however often a step asks (a fixed Newton step and the minimiser
+  // that takes it over both do).
+  bool changedSinceLastStep() const;
 
   // `q`: the current state, to rotate the force into the vertex's frame under modal warping.
   void addVertexForce(const qv_model& model, qv_elasticity elasticity, const double* q, int vertex,

@@ -44,7 +44,7 @@ bool settleEnergyAccount(qv_instance& s, bool loadsChanged) {
 const double* beginFixedNewton(qv_instance& s, double& budget) {
   elasticityAt(s, s.q, &s.elasticEnergyAtState, s.work.force);
   const double* J = s.loads.addStateForces(s.q, s.work.force);
-  const bool loadsChanged = s.loads.changedSinceLastStep();  // read once: it clears the flag
+  const bool loadsChanged = s.loads.changedSinceLastStep();
   if (settleEnergyAccount(s, loadsChanged)) {  // drawn back: the step starts from there
     elasticityAt(s, s.q, &s.elasticEnergyAtState, s.work.force);
     J = s.loads.addStateForces(s.q, s.work.force);
