@@ -6,6 +6,7 @@
 #include <cstring>
 #include <utility>
 
+#include "c_enum.h"
 #include "triangle_mesh.h"
 
 namespace quiver::rt {
@@ -595,7 +596,7 @@ bool validCollider(const qv_collider& c) {
       !finiteAll(c.angular_velocity, 3) || !(c.friction >= 0) || !std::isfinite(c.friction) ||
       !(c.restitution >= 0) || !(c.restitution <= 1))
     return false;
-  switch (c.type) {
+  switch (cEnumValue(c.type)) {
     case QV_COLLIDER_PLANE: return dot3(c.data, c.data) > 0;
     case QV_COLLIDER_SPHERE: return c.data[3] > 0;
     case QV_COLLIDER_BOX: return c.data[3] > 0 && c.data[4] > 0 && c.data[5] > 0;

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <new>
 
+#include "c_enum.h"
 #include "contact.h"
 #include "dense_solve.h"
 #include "dynamics.h"
@@ -14,16 +15,17 @@
 namespace quiver::rt {
 
 bool validConfig(const qv_model* model, const qv_instance_config* c) {
-  return model && c && c->integrator >= 0 && c->integrator < QV_INTEGRATOR_COUNT && c->solver >= 0 &&
-         c->solver < QV_SOLVER_COUNT && c->newton_tolerance > 0 && std::isfinite(c->newton_tolerance) &&
-         c->elasticity >= 0 &&
-         c->elasticity < QV_ELASTICITY_COUNT && (!kElasticities[c->elasticity].needsRotations || model->rotations) &&
+  if (!model || !c) return false;
+  const int integrator = cEnumValue(c->integrator), solver = cEnumValue(c->solver), elasticity = cEnumValue(c->elasticity);
+  return integrator >= 0 && integrator < QV_INTEGRATOR_COUNT && solver >= 0 && solver < QV_SOLVER_COUNT &&
+         c->newton_tolerance > 0 && std::isfinite(c->newton_tolerance) && elasticity >= 0 &&
+         elasticity < QV_ELASTICITY_COUNT && (!kElasticities[elasticity].needsRotations || model->rotations) &&
          c->time_step > 0 && std::isfinite(c->time_step) && c->newton_iterations >= 1 && c->rayleigh_alpha >= 0 &&
          c->rayleigh_beta >= 0 && c->max_constraints >= 0 && c->max_constraints <= 64 && c->max_displacement > 0 &&
          (c->free_flight == 0 || (c->free_flight == 1 && model->rigidBody)) && c->max_contacts >= 0 &&
          c->max_contacts <= 4096 && (c->soft_contacts == 0 || (c->soft_contacts == 1 && c->free_flight == 1 &&
-                                                                c->integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES &&
-                                                                c->elasticity != QV_ELASTICITY_MODAL_WARPING));
+                                                                integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES &&
+                                                                elasticity != QV_ELASTICITY_MODAL_WARPING));
 }
 
 void defaultConfig(qv_instance_config& config, const qv_model* model) {
