@@ -15,8 +15,8 @@
 //
 // Asked for the energy alone (the energy budgets' checks and draw-backs), evaluate() sums the
 // monomials themselves, each degree's coefficients for a fixed leading index (or pair) against the
-// contiguous tail of the pair products q_k q_l that completes them: 47k multiply-adds at r = 30
-// from 0.37 MB, against the packed product's 230k from 0.91 MB (a copy of the file's coefficients,
+// contiguous tail of the pair products q_k q_l that completes them: 50k multiply-adds at r = 30
+// from 0.40 MB (runs padded to 16), against the packed product's 230k from 0.91 MB (a copy of the file's coefficients,
 // as the stored layout rounds them, so that it matches the full evaluation's energy to rounding).
 //
 // Groups of states (evaluateLanes), where the arithmetic, not the memory, bounds the work, contract

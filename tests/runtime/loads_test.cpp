@@ -43,4 +43,10 @@ TEST(Loads, ChangedSinceLastStepGivesOneAnswerPerStep) {
   loads.endStep();
   loads.addReducedForce(push);
   EXPECT_FALSE(loads.changedSinceLastStep());  // the next step's loads are the last step's
+  loads.endStep();
+  loads.changed = true;  // a step that never asks (central differences) still spends the record
+  loads.addReducedForce(push);
+  loads.endStep();
+  loads.addReducedForce(push);
+  EXPECT_FALSE(loads.changedSinceLastStep());
 }

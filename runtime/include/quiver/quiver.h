@@ -80,8 +80,9 @@ typedef struct qv_model_info {
 /* How a model is held in memory. Fill with qv_model_config_init(). */
 typedef struct qv_model_config {
   int coefficient_precision; /* 64 (default): the baked coefficients exactly; 32: the packed quartic
-                                in float32 (0.97 MB instead of 1.43 at r = 30), force and stiffness
-                                within about 1e-7 relative (bench/README.md) */
+                                in float32 (at r = 30: 0.97 MB instead of 1.43 without the groups'
+                                layout, 1.62 instead of 2.67 with it), force and stiffness within
+                                about 1e-7 relative (bench/README.md) */
   int group_layout;          /* 1: also lay the quartic coefficients out for qv_instances_step's groups
                                 of 8 (crowds step about 20% faster; 2.67 MB instead of 1.43 at r = 30
                                 in float64, 38 MB instead of 20 at r = 60); 0: not, and
@@ -167,8 +168,8 @@ typedef enum qv_solver {
                              anyway), from the velocity or, where the position alone holds more, by drawing the state
                              back toward the last step's start; so a state handed out may hold more than its budget
                              for one step, and after a draw-back the next 60 steps are held to it at their ends at
-                             one more evaluation each (released undamped from a 180-degree twist at one iteration, a sliver
-                             beam's energy exceeded that at the release at 6 of 480 step ends, at most 8.2 times
+                             one more evaluation of the energy each (released undamped from a 180-degree twist at one iteration, a sliver
+                             beam's energy exceeded that at the release at 6-7 of 480 step ends, at most 8.2 times
                              it; 84% of them, and a runaway, in runtime 0.11). Where strains are large (stiff
                              springs, large twists, long time steps, sudden loads and releases) the iterations can
                              diverge: a step whose system is not positive definite, or whose end may move a vertex
