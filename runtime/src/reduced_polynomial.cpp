@@ -260,12 +260,25 @@ void ReducedPolynomial::build(int r, const double* c, bool single, bool groups, 
         for (int x = 0; x < 3; ++x)
           for (int y = x + 1; y < 3; ++y) t[blockedAt(r, pairIndex(r, idx[x], idx[y]), idx[3 - x - y])] = T;
       }
+  // The energy's monomials (monomials_), in the file's order: sorted tuples in lexicographic order,
+  // so a run (padded to whole kRun) is the file's coefficients for its leading index or pair. The
+  // quartic's as the stored layout rounds them: float32 holds the tensor entries, the coefficients
+  // times repeatFactor().
+  double* to = arrays.monomials;
+  std::memcpy(to, c2, sizeof(double) * P);
+  to += wholeRuns(P);
+  for (int i = 0; i < r; ++i) {
+    std::memcpy(to, c3 + monomialIndex3(r, i, i, i), sizeof(double) * tailFrom(r, i));
+    to += wholeRuns(tailFrom(r, i));
+  }
   for (int i = 0; i < r; ++i)
-    for (int j = i; j < r; ++j)
-      for (int k = j; k < r; ++k)
-        for (int l = k; l < r; ++l) {
+    for (int j = i; j < r; to += wholeRuns(tailFrom(r, j)), ++j)  // one run per leading pair
+      for (int k = j, run = 0; k < r; ++k)
+        for (int l = k; l < r; ++l, ++run) {
           const int idx[4] = {i, j, k, l};
-          const double value = c4[monomialIndex4(r, i, j, k, l)] * repeatFactor(idx);
+          const double coefficient = c4[monomialIndex4(r, i, j, k, l)], factor = repeatFactor(idx);
+          const double value = coefficient * factor;
+          to[run] = single ? static_cast<double>(static_cast<float>(value)) / factor : coefficient;
           for (int x = 0; x < 4; ++x)
             for (int y = x + 1; y < 4; ++y) {
               int rest[2], n = 0;
@@ -285,29 +298,6 @@ void ReducedPolynomial::build(int r, const double* c, bool single, bool groups, 
               arrays.d64[at] = value / 2;
           }
         }
-  // The monomials' runs, in the file's order (sorted tuples in lexicographic order, so a run is the
-  // file's coefficients for its leading index or pair), each padded to whole kRun. The quartic's as
-  // the stored layout rounds them: float32 holds the tensor entries, the coefficients times
-  // repeatFactor().
-  double* to = arrays.monomials;
-  std::memcpy(to, c2, sizeof(double) * P);
-  to += wholeRuns(P);
-  for (int i = 0; i < r; ++i) {
-    std::memcpy(to, c3 + monomialIndex3(r, i, i, i), sizeof(double) * tailFrom(r, i));
-    to += wholeRuns(tailFrom(r, i));
-  }
-  for (int i = 0; i < r; ++i)
-    for (int j = i; j < r; ++j) {
-      size_t s = 0;
-      for (int k = j; k < r; ++k)
-        for (int l = k; l < r; ++l, ++s) {
-          const double value = c4[monomialIndex4(r, i, j, k, l)];
-          const int idx[4] = {i, j, k, l};
-          const double f = repeatFactor(idx);
-          to[s] = single ? static_cast<double>(static_cast<float>(value * f)) / f : value;
-        }
-      to += wholeRuns(s);
-    }
   for (int a = 0, p = 0; groups && a < r; ++a)
     for (int b = a; b < r; ++b, ++p)
       for (int k = 0; k < r; ++k) {
