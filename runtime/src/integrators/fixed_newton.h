@@ -20,9 +20,8 @@
 // from the step's start), at one more evaluation each; an excess the velocity covers (common under
 // sudden pushes: 13-30% of the energy under the runtime bench's load) arms none, for at 60 steps
 // each it had nearly doubled that bench's step. (An undamped sliver beam released from a 180-degree
-// twist at one iteration: 6-7 of 480 steps
-// ended above its energy at the release, the highest at 8.2 times it; in runtime 0.11, 84% did, at
-// a median of 33 times it, and it ran away.)
+// twist at one iteration: 6-7 of 480 steps ended above its energy at the release, the highest at
+// 8.2 times it; in runtime 0.11, 84% did, at a median of 33 times it, and it ran away.)
 #include "integrator.h"
 
 namespace quiver::rt {
