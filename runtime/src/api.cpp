@@ -9,6 +9,7 @@
 #include <cstring>
 #include <string>
 
+#include "c_enum.h"
 #include "contact.h"
 #include "elasticity.h"
 #include "instance.h"
@@ -53,7 +54,8 @@ bool validVertices(const qv_instance* s, const int* vertices, int count) {
   return true;
 }
 
-// A field of row `index` of a name table, or null out of range.
+// A field of row `index` of a name table, or null out of range (a C caller may pass any int as
+// the enum: read it with cEnumValue()).
 template <class Entry, size_t N>
 const char* entry(const Entry (&table)[N], int index, const char* Entry::*field) {
   return index >= 0 && index < static_cast<int>(N) ? table[index].*field : nullptr;
@@ -84,7 +86,7 @@ int qv_check_version(int version_number, size_t model_info_size, size_t instance
 }
 
 const char* qv_result_string(qv_result result) {
-  switch (result) {
+  switch (cEnumValue(result)) {
     case QV_OK: return "ok";
     case QV_ERROR_INVALID_ARGUMENT: return "invalid argument";
     case QV_ERROR_IO: return "input/output error";
@@ -94,18 +96,22 @@ const char* qv_result_string(qv_result result) {
   return "unknown result";
 }
 
-const char* qv_integrator_name(qv_integrator i) { return entry(kIntegrators, i, &IntegratorEntry::name); }
-const char* qv_integrator_description(qv_integrator i) { return entry(kIntegrators, i, &IntegratorEntry::description); }
+const char* qv_integrator_name(qv_integrator i) { return entry(kIntegrators, cEnumValue(i), &IntegratorEntry::name); }
+const char* qv_integrator_description(qv_integrator i) {
+  return entry(kIntegrators, cEnumValue(i), &IntegratorEntry::description);
+}
 qv_result qv_integrator_from_name(const char* name, qv_integrator* integrator) {
   return fromName(kIntegrators, name, integrator);
 }
-const char* qv_elasticity_name(qv_elasticity e) { return entry(kElasticities, e, &ElasticityEntry::name); }
-const char* qv_elasticity_description(qv_elasticity e) { return entry(kElasticities, e, &ElasticityEntry::description); }
+const char* qv_elasticity_name(qv_elasticity e) { return entry(kElasticities, cEnumValue(e), &ElasticityEntry::name); }
+const char* qv_elasticity_description(qv_elasticity e) {
+  return entry(kElasticities, cEnumValue(e), &ElasticityEntry::description);
+}
 qv_result qv_elasticity_from_name(const char* name, qv_elasticity* elasticity) {
   return fromName(kElasticities, name, elasticity);
 }
-const char* qv_solver_name(qv_solver v) { return entry(kSolvers, v, &SolverEntry::name); }
-const char* qv_solver_description(qv_solver v) { return entry(kSolvers, v, &SolverEntry::description); }
+const char* qv_solver_name(qv_solver v) { return entry(kSolvers, cEnumValue(v), &SolverEntry::name); }
+const char* qv_solver_description(qv_solver v) { return entry(kSolvers, cEnumValue(v), &SolverEntry::description); }
 qv_result qv_solver_from_name(const char* name, qv_solver* solver) { return fromName(kSolvers, name, solver); }
 
 // ---- Models ----

@@ -4,6 +4,7 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "quiver/quiver.h"
 
@@ -56,6 +57,10 @@ int main(int argc, char** argv) {
   qv_instance_energies(instance, &kinetic, &elastic);
   CHECK(kinetic == 0 && elastic == 0);
   CHECK(qv_result_string(QV_ERROR_FORMAT)[0] != '\0');
+  /* Any int is a valid enum value in C: out of range, names are null and results "unknown". */
+  CHECK(strcmp(qv_result_string((qv_result)42), "unknown result") == 0);
+  CHECK(qv_solver_name((qv_solver)9) == NULL && qv_integrator_description((qv_integrator)-1) == NULL);
+  CHECK(qv_elasticity_name((qv_elasticity)7) == NULL && strcmp(qv_solver_name(QV_SOLVER_MINIMIZE), "minimize") == 0);
 
   /* A crowd in one call (9 instances: 2 jobs of a group each), its pieces run by a job runner of
      our own (here: one after the other). */
