@@ -1,5 +1,6 @@
 // The runtime's hot paths on baked models, single thread (Google Benchmark):
-//   Evaluate/force, Evaluate/force+stiffness (float64 and float32 coefficients), Step/newton
+//   Evaluate/force, Evaluate/force+stiffness (float64 and float32 coefficients), EvaluateGroup
+//   (eight states at once, as qv_instances_step evaluates them; both precisions), Step/newton
 //   (implicit Newmark, Barbic & James's one Newton iteration; both precisions), Step/minimize (the
 //   default solver), both under a load that keeps the object moving, and ManyObjects: 1000
 //   instances of one model stepped per frame (both solvers, one by one and in one
@@ -21,6 +22,7 @@
 #include "formats/model/fnv1a.h"
 #include "formats/model/qvr.h"
 #include "quiver/quiver.h"
+#include "runtime/src/model.h"
 #include "runtime/src/reduced_polynomial.h"
 
 namespace {
@@ -42,14 +44,24 @@ double evaluationFlops(int r) {
   return 4 * P * (P + 1) / 2 + 2 * r * P + 10 * P;
 }
 
+// The same for a group of ReducedPolynomial::kLanes states (evaluateLanes): the quartic's two
+// passes (C(r+2,3) r and P r multiply-adds per state), the cubic's (P r) and the per-pair
+// assembly.
+double groupFlops(int r) {
+  const double P = r * (r + 1) / 2.0, T = r * (r + 1) * (r + 2) / 6.0;
+  return quiver::rt::ReducedPolynomial::kLanes * (2 * r * (T + 2 * P) + 10 * P);
+}
+
 struct Loaded {
   qv_model* model = nullptr;
   qv_model_info info{};
-  explicit Loaded(const char* path, int precision = 64) {
+  // groupLayout: qv_model_config.group_layout (-1, the default: as the runtime decides).
+  explicit Loaded(const char* path, int precision = 64, int groupLayout = -1) {
     char message[512];
     qv_model_config config;
     qv_model_config_init(&config);
     config.coefficient_precision = precision;
+    config.group_layout = groupLayout;
     if (qv_model_load_file(path, &config, nullptr, &model, message, sizeof message) != QV_OK) {
       std::fprintf(stderr, "%s\n", message);
       std::exit(1);
@@ -132,6 +144,35 @@ void Evaluate(benchmark::State& state, const char* path, Asked asked, int precis
   if (asked != Asked::energy)
     state.counters["GFLOPS"] = benchmark::Counter(evaluationFlops(r) * state.iterations(), benchmark::Counter::kIsRate,
                                                   benchmark::Counter::kIs1000);
+  qv_model_destroy(m.model);
+}
+
+// One evaluation of force, energy and stiffness for a group of kLanes states at once, as
+// qv_instances_step evaluates them (the arithmetic, not the coefficients' bytes, bounds it:
+// compare GFLOPS with PeakFma's).
+void EvaluateGroup(benchmark::State& state, const char* path, int precision) {
+  using quiver::rt::ReducedPolynomial;
+  Loaded m(path, precision, 1);
+  const int r = m.info.r, L = ReducedPolynomial::kLanes;
+  const size_t P = static_cast<size_t>(r) * (r + 1) / 2;
+  std::vector<double> q(static_cast<size_t>(r) * L), force(q.size()), energy(L), K(P * L);
+  double* scratch = static_cast<double*>(std::aligned_alloc(64, (ReducedPolynomial::laneScratchSize(r) * 8 + 63) / 64 * 64));
+  const double* at[L];
+  double* f[L];
+  for (int l = 0; l < L; ++l) {
+    for (int i = 0; i < r; ++i) q[l * r + i] = 1e-3 * (i + 1 + l);
+    at[l] = q.data() + l * r;
+    f[l] = force.data() + l * r;
+  }
+  for (auto _ : state) {
+    m.model->polynomial.evaluateLanes(at, L, energy.data(), f, K.data(), scratch);
+    benchmark::DoNotOptimize(K.data());
+    q[0] += 1e-12;
+  }
+  state.counters["r"] = r;
+  state.counters["GFLOPS"] =
+      benchmark::Counter(groupFlops(r) * state.iterations(), benchmark::Counter::kIsRate, benchmark::Counter::kIs1000);
+  std::free(scratch);
   qv_model_destroy(m.model);
 }
 
@@ -235,6 +276,10 @@ int main(int argc, char** argv) {
         ->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("Evaluate/force+stiffness/f32" + r).c_str(), Evaluate, path, Asked::forceAndStiffness, 32)
         ->Unit(benchmark::kMicrosecond);
+    for (int precision : {64, 32})
+      benchmark::RegisterBenchmark(("EvaluateGroup" + std::string(precision == 32 ? "/f32" : "") + r).c_str(),
+                                   EvaluateGroup, path, precision)
+          ->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("Evaluate/energy" + r).c_str(), Evaluate, path, Asked::energy, 64)->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("Step/newton" + r).c_str(), Step, path, QV_SOLVER_NEWTON, 64)->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("Step/newton/f32" + r).c_str(), Step, path, QV_SOLVER_NEWTON, 32)->Unit(benchmark::kMicrosecond);
