@@ -39,6 +39,12 @@ def vega_steps(shared, tmp, repetitions):
     return steps
 
 
+def heading(*columns, text=("solver",)):
+    """A markdown table's header row and its alignment row (numbers right, `text` columns left)."""
+    print("| " + " | ".join(columns) + " |")
+    print("|" + "|".join("---" if c in text else "---:" for c in columns) + "|")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default="build/release")
@@ -71,11 +77,9 @@ def main():
     peak_gflops = peak["GFLOPS"] / 1e9 if peak else float("nan")
     print(machine_line())
     print(f"Peak FMA throughput of this core, measured in the same run: {peak_gflops:.1f} GFLOP/s (double, its widest vectors)\n")
-    print("| r | force (us) | force + stiffness (us) | energy alone (us) | Newmark step, fixed Newton (us) "
-          "| its steps the minimiser took "
-          "| Vega-like step, same run (us) | x Vega | Newmark step, minimise (us) | its Newton iterations "
-          "| evaluation GFLOP/s | fraction of peak |")
-    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    heading("r", "force (us)", "force + stiffness (us)", "energy alone (us)", "Newmark step, fixed Newton (us)",
+            "its steps the minimiser took", "Vega-like step, same run (us)", "x Vega", "Newmark step, minimise (us)",
+            "its Newton iterations", "evaluation GFLOP/s", "fraction of peak")
     for r in RANKS:
         f, fk, energy = get(f"Evaluate/force/r{r}"), get(f"Evaluate/force+stiffness/r{r}"), get(f"Evaluate/energy/r{r}")
         newton, minimize = get(f"Step/newton/r{r}"), get(f"Step/minimize/r{r}")
@@ -86,9 +90,9 @@ def main():
               f"{reference / newton['real_time']:.1f} | {minimize['real_time']:.2f} | {minimize['newton_per_step']:.2f} | {gflops:.1f} | {gflops / peak_gflops:.0%} |")
     print("\nCoefficient precision and the memory floor (force + stiffness; *stream* reads the same bytes as "
           "doubles, same run):\n")
-    print("| r | one state reads, f64 (MB) | evaluation f64 (us) | stream f64 (us) | f64 / stream | evaluation f32 (us) "
-          "| stream f32 (us) | f32 / stream | f32 speed-up | Newmark step f64 (us) | Newmark step f32 (us) |")
-    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    heading("r", "one state reads, f64 (MB)", "evaluation f64 (us)", "stream f64 (us)", "f64 / stream",
+            "evaluation f32 (us)", "stream f32 (us)", "f32 / stream", "f32 speed-up", "Newmark step f64 (us)",
+            "Newmark step f32 (us)")
     for r in RANKS:
         e64, e32 = get(f"Evaluate/force+stiffness/r{r}"), get(f"Evaluate/force+stiffness/f32/r{r}")
         s64, s32 = get(f"Stream/f64/r{r}"), get(f"Stream/f32/r{r}")
@@ -99,18 +103,16 @@ def main():
               f"{n64['real_time']:.2f} | {n32['real_time']:.2f} |")
     print("\nGroups of eight states evaluated at once (force, stiffness and energy, as qv_instances_step "
           "evaluates them): the crowd's arithmetic, against the same run's peak:\n")
-    print("| r | group f64 (us) | GFLOP/s | fraction of peak | group f32 (us) | 1000 states f64 (ms) "
-          "| 1000 states at the peak (ms) |")
-    print("|---:|---:|---:|---:|---:|---:|---:|")
+    heading("r", "group f64 (us)", "GFLOP/s", "fraction of peak", "group f32 (us)", "1000 states f64 (ms)",
+            "1000 states at the peak (ms)")
     for r in RANKS:
         g64, g32 = get(f"EvaluateGroup/r{r}"), get(f"EvaluateGroup/f32/r{r}")
         gflops = g64["GFLOPS"] / 1e9
         print(f"| {r} | {g64['real_time']:.1f} | {gflops:.1f} | {gflops / peak_gflops:.0%} | {g32['real_time']:.1f} | "
               f"{g64['real_time'] * 125 / 1e3:.2f} | {g64['real_time'] * 125 / 1e3 * gflops / peak_gflops:.2f} |")
     print("\nMany objects: 1000 instances per frame on one core, each under its own push (bench/runtime.cpp):\n")
-    print("| r | solver | one by one (ms per frame) | qv_instances_step (ms per frame) | speed-up | resets "
-          "| fixed Newton steps the minimiser took |")
-    print("|---:|---|---:|---:|---:|---:|---:|")
+    heading("r", "solver", "one by one (ms per frame)", "qv_instances_step (ms per frame)", "speed-up", "resets",
+            "fixed Newton steps the minimiser took")
     for r in (20, 30):
         for solver in ("newton", "minimize"):
             alone, together = get(f"ManyObjects/{solver}/one-by-one/r{r}/1000"), get(f"ManyObjects/{solver}/together/r{r}/1000")
