@@ -14,11 +14,16 @@ namespace quiver {
 
 namespace fs = std::filesystem;
 
-std::string readFileBytes(const std::string& path) {
+std::ifstream openForReading(const std::string& path) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw MeshError(path + ": cannot open: is a directory");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw MeshError(path + ": cannot open: " + std::strerror(errno));
+  return in;
+}
+
+std::string readFileBytes(const std::string& path) {
+  std::ifstream in = openForReading(path);
   std::ostringstream buf;
   buf << in.rdbuf();
   if (in.bad()) throw MeshError(path + ": read error");

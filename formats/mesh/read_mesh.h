@@ -2,6 +2,7 @@
 // Reading tetrahedral meshes. The parse* functions work on bytes already in memory (tests and
 // fuzzers call them directly); readMeshFile() picks the format from the extension and content.
 // None of them validates geometry: see common/mesh_checks.h.
+#include <fstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -28,7 +29,10 @@ RawMesh parseTetGen(std::string_view nodeBytes, std::string_view eleBytes, const
 // Returns 0-based indices in file vertex order, checked against `vertexCount`.
 std::vector<int> parseBou(std::string_view bytes, const std::string& file, int vertexCount);
 
-// The whole file, or MeshError "PATH: cannot open: <reason>".
+// The file opened, or MeshError "PATH: cannot open: <reason>" (a directory opens as a stream that
+// reads nothing).
+std::ifstream openForReading(const std::string& path);
+// The whole file, or the same MeshError.
 std::string readFileBytes(const std::string& path);
 
 // From the extension (.node/.ele/.msh/.mesh/.veg/.vtk/.vtu) and, for .mesh, the first line.

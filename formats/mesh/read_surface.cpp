@@ -112,7 +112,9 @@ bool isTetMeshPath(const std::string& path) {
 }
 
 SurfaceMesh readSurfaceFile(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw MeshError(path + ": cannot open: no such file");
+  openForReading(path);  // Assimp says no more than that it found no reader
+  if (std::filesystem::path(path).extension() == ".qvr")
+    throw MeshError(path + ": a baked model (.qvr), not a mesh: bake the mesh it was baked from");
   if (isTetMeshPath(path)) return tetBoundary(path);
   Assimp::Importer importer;
   configure(importer, path);

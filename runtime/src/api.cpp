@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <string>
 
 #include "c_enum.h"
@@ -153,6 +154,12 @@ qv_result qv_model_load_file(const char* path, const qv_model_config* config, co
   if (!model || !path) return QV_ERROR_INVALID_ARGUMENT;
   *model = nullptr;
   const qv_allocator use = allocatorOr(allocator);
+  // fopen() opens a directory, whose size then reads as LONG_MAX.
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) {
+    report(message, message_size, std::string(path) + ": is a directory, not a model file");
+    return QV_ERROR_IO;
+  }
   FILE* file = std::fopen(path, "rb");
   if (!file) {
     report(message, message_size, std::string(path) + ": cannot open: " + std::strerror(errno));
@@ -169,6 +176,7 @@ qv_result qv_model_load_file(const char* path, const qv_model_config* config, co
   void* buffer = use.allocate(length ? static_cast<size_t>(length) : 1, 64, use.user);
   if (!buffer) {
     std::fclose(file);
+    report(message, message_size, std::string(path) + ": cannot allocate " + std::to_string(length) + " bytes to read it");
     return QV_ERROR_OUT_OF_MEMORY;
   }
   const bool complete = std::fread(buffer, 1, static_cast<size_t>(length), file) == static_cast<size_t>(length);

@@ -30,6 +30,10 @@ int main(int argc, char** argv) {
   qv_model* model = NULL;
   char message[256];
   CHECK(qv_model_load_file("/nonexistent.qvr", NULL, NULL, &model, message, sizeof message) == QV_ERROR_IO && !model);
+  CHECK(strstr(message, "/nonexistent.qvr: cannot open") == message);
+  /* fopen() opens a directory, and its size reads as LONG_MAX: it once failed as out of memory, unsaid. */
+  CHECK(qv_model_load_file("/", NULL, NULL, &model, message, sizeof message) == QV_ERROR_IO && !model);
+  CHECK(strcmp(message, "/: is a directory, not a model file") == 0);
   CHECK(qv_model_load_file(argv[1], NULL, NULL, &model, message, sizeof message) == QV_OK && model);
   qv_model_info info;
   qv_model_get_info(model, &info);

@@ -51,7 +51,14 @@ TEST(ReadSurface, WhatIsNotASurfaceIsNamed) {
   } catch (const MeshError& e) {
     EXPECT_EQ(std::string(e.what()).rfind("notes.obj: ", 0), 0u) << e.what();
   }
-  EXPECT_THROW(readSurfaceFile("/nonexistent/x.obj"), MeshError);
+  EXPECT_EQ(test::errorOf<MeshError>([] { readSurfaceFile("/nonexistent/x.obj"); }),
+            "/nonexistent/x.obj: cannot open: No such file or directory");
+  // A directory was once "no such file"; a baked model, Assimp's "no suitable reader".
+  const std::string directory = std::filesystem::temp_directory_path().string();
+  EXPECT_EQ(test::errorOf<MeshError>([&] { readSurfaceFile(directory); }), directory + ": cannot open: is a directory");
+  const std::string model = test::asset("../fuzz/seeds/qvr/float64.qvr");
+  EXPECT_NE(test::errorOf<MeshError>([&] { readSurfaceFile(model); }).find("a baked model (.qvr), not a mesh"),
+            std::string::npos);
 }
 
 TEST(ReadSurface, PolygonsTooLargeToTriangulateAreRefusedInEveryFormat) {
