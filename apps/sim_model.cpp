@@ -66,7 +66,13 @@ int simulateModel(const std::string& path, const SimOptions& o) {
                 << (model.info().render_vertex_count ? ", " + o.output + "_render.pvd (the render mesh)" : std::string()) << " and "
                 << o.output << ".csv\n";
   }
-  return result.failedSteps > 0 ? 2 : 0;
+  if (result.failedSteps > 0) {
+    std::cerr << "quiver sim: warning: the state went non-finite " << result.failedSteps
+              << " times and the runtime reset it to rest (exit code 2): the load is too large for this model or "
+                 "this time step\n";
+    return 2;
+  }
+  return 0;
 }
 
 } // namespace quiver::app

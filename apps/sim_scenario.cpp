@@ -18,15 +18,21 @@ namespace quiver::app {
 
 void SimOptions::addScenarioTo(CLI::App& app) {
   app.add_option("--steps", steps, "Steps to simulate")->capture_default_str()->check(Positive);
-  app.add_option("--hold", holdSteps, "Steps the load acts before it is released")->capture_default_str();
+  app.add_option("--hold", holdSteps, "Steps the load acts before it is released")->capture_default_str()->check(NonNegative);
   app.add_option("--group", group, "Loaded vertices, a selector such as \"x>max-1e-6\" (mesh units)")->capture_default_str();
-  app.add_option("--force", force, "Pull: total force on the group, N, as fx,fy,fz")->delimiter(',')->expected(3);
-  app.add_option("--drag", drag, "Drag: move the group's targets by dx,dy,dz (m) over the hold")->delimiter(',')->expected(3);
-  app.add_option("--twist", twist, "Drag: rotate the group's targets by this many degrees over the hold");
+  app.add_option("--force", force, "Pull: total force on the group, N, as fx,fy,fz")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(Finite);
+  app.add_option("--drag", drag, "Drag: move the group's targets by dx,dy,dz (m) over the hold")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(Finite);
+  app.add_option("--twist", twist, "Drag: rotate the group's targets by this many degrees over the hold")->check(Finite);
   app.add_option("--axis", axis, "Drag: the twist axis, through the group's centre")
       ->capture_default_str()
       ->check(CLI::IsMember({"x", "y", "z"}));
-  app.add_option("--stiffness", stiffness, "Drag: penalty spring per vertex, N/m")->capture_default_str();
+  app.add_option("--stiffness", stiffness, "Drag: penalty spring per vertex, N/m")->capture_default_str()->check(Positive);
   app.add_flag("--gravity", gravity, "Gravity, 9.81 m/s^2 along -z");
   app.add_flag("--free", step.freeFlight, "Fly: rigid motion with the deformation (a model baked with no fixed vertex)");
   app.add_flag("--soft-contacts", step.softContacts,
@@ -37,8 +43,8 @@ void SimOptions::addScenarioTo(CLI::App& app) {
                  "Newton iterations per implicit step: the most (--solver minimize, default 8; full space, default 20) "
                  "or exactly (--solver newton)")
       ->check(Positive);
-  app.add_option("--alpha", step.alpha, "Mass-proportional damping, 1/s");
-  app.add_option("--beta", step.beta, "Stiffness-proportional damping, s");
+  app.add_option("--alpha", step.alpha, "Mass-proportional damping, 1/s (default: the model's)")->check(NonNegative);
+  app.add_option("--beta", step.beta, "Stiffness-proportional damping, s (default: the model's)")->check(NonNegative);
   app.add_option("--scenario", scenarioFile,
                  "Read scenario options from FILE, one 'name = value' per line (apps/support/scenario_file.h)");
 }

@@ -90,6 +90,7 @@ CLI::Validator numberWhere(bool (*holds)(double), const std::string& expected, c
 const CLI::Validator Positive = numberWhere([](double x) { return x > 0 && std::isfinite(x); }, "a positive number", "POSITIVE");
 const CLI::Validator NonNegative =
     numberWhere([](double x) { return x >= 0 && std::isfinite(x); }, "a number >= 0", "NON-NEGATIVE");
+const CLI::Validator Finite = numberWhere([](double x) { return std::isfinite(x); }, "a finite number", "FINITE");
 
 int runTool(const std::string& tool, CLI::App& app, int argc, char** argv, const std::function<int()>& body,
             const ArgumentRewrite& rewrite) {

@@ -44,6 +44,8 @@ bool parseNumber(const std::string& text, double& value);
 // to 1.79e308" of a word, and prints that bound in full; these say what is expected.
 extern const CLI::Validator Positive;
 extern const CLI::Validator NonNegative;
+// Any finite number (a vector option checks each of its values).
+extern const CLI::Validator Finite;
 
 // Rewrites the command line (without the program name) before it is parsed; may throw.
 using ArgumentRewrite = std::function<std::vector<std::string>(const std::vector<std::string>&)>;

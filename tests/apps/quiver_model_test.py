@@ -191,10 +191,25 @@ class QuiverSim(OnTheBakedModel):
 
     def test_bad_options(self):
         for args, message in ((["--group", "x<-5"], "selects no vertex"), (["--group", "q<1"], "--group"),
-                              (["--dt", "-1"], "--dt"), (["--newton", "0"], "--newton"), (["--solver", "gauss"], "gauss")):
+                              (["--dt", "-1"], "--dt"), (["--newton", "0"], "--newton"), (["--solver", "gauss"], "gauss"),
+                              # Once taken: a NaN load reset the model every step, a spring of no stiffness
+                              # did nothing, and a negative damping meant the model's.
+                              (["--force", "nan,0,0"], "--force: expected a finite number, not 'nan'"),
+                              (["--twist", "inf"], "--twist: expected a finite number"),
+                              (["--drag", "0,0,0.1", "--stiffness", "0"], "--stiffness: expected a positive number"),
+                              (["--alpha", "-100"], "--alpha: expected a number >= 0"),
+                              (["--beta", "nan"], "--beta: expected a number >= 0"),
+                              (["--hold", "-5"], "--hold: expected a number >= 0")):
             p = self.sim(*args, ok=False)
             self.assertNotEqual(p.returncode, 0)
             self.assertIn(message, p.stderr)
+
+    def test_a_load_the_model_cannot_take_is_reported(self):
+        # 1e300 N at the tip: its work overflows, every step goes non-finite, and the runtime resets the
+        # bar to rest.
+        p = self.sim("--force", "0,0,-1e300", "--steps", "5", ok=False)
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("went non-finite 5 times and the runtime reset it to rest", p.stderr)
 
 
 class QuiverRender(OnTheBakedModel):
