@@ -6,12 +6,16 @@
 
 namespace quiver::app {
 
+void warnAboveStableStep(const RuntimeInstance& instance) {
+  const double stable = qv_instance_stable_time_step(instance.get());
+  if (instance.config().integrator == QV_INTEGRATOR_CENTRAL_DIFFERENCES && instance.config().time_step > stable)
+    std::cerr << "quiver: warning: --dt " << instance.config().time_step << " s is above central differences' stable step "
+              << stable << " s (with this damping)\n";
+}
+
 RuntimeTarget::RuntimeTarget(const RuntimeModel& model, const StepSettings& settings)
     : model_(model), instance_(model, instanceConfig(model.get(), settings)) {
-  const double stable = qv_instance_stable_time_step(instance_.get());
-  if (instance_.config().integrator == QV_INTEGRATOR_CENTRAL_DIFFERENCES && instance_.config().time_step > stable)
-    std::cerr << "quiver: warning: --dt " << instance_.config().time_step << " s is above central differences' stable step "
-              << stable << " s\n";
+  warnAboveStableStep(instance_);
 }
 
 void RuntimeTarget::addVertexForce(int vertex, const double force[3]) {

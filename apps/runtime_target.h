@@ -9,6 +9,10 @@
 
 namespace quiver::app {
 
+// Warns on stderr ("quiver: warning: ...") when `instance` steps by central differences above its
+// stable step.
+void warnAboveStableStep(const RuntimeInstance& instance);
+
 class RuntimeTarget : public ScenarioTarget {
 public:
   RuntimeTarget(const RuntimeModel& model, const StepSettings& settings);

@@ -51,6 +51,7 @@ int simulateCrowd(const std::string& path, const SimOptions& o, const CrowdOptio
   for (int k = 0; k < n; ++k) {
     owned.push_back(std::make_unique<RuntimeInstance>(model, config));
     instances.push_back(owned.back()->get());
+    if (k == 0) warnAboveStableStep(*owned.back());
     if (o.gravity) {
       const double g[3] = {0, 0, -kGravity};
       qv_instance_set_gravity(instances.back(), g);

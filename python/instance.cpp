@@ -307,7 +307,7 @@ colliders persist. Positions and normals are in the world (in flight, carried by
       .def_property_readonly("flying", [](const Instance& self) { return self.config.free_flight != 0; })
       .def_property_readonly("time_step", [](const Instance& self) { return self.config.time_step; })
       .def_property_readonly("stable_time_step", [](const Instance& self) { return qv_instance_stable_time_step(self.use()); },
-                             "largest stable step of central differences at rest, s")
+                             "largest stable step of central differences at rest under its Rayleigh damping, s")
       .def("step", [](Instance& self, long long count) {
              if (count < 0) throw py::value_error("count must be >= 0");
              if (self.world) throw py::value_error("this instance is in a World, which steps it (World.step)");

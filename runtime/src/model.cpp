@@ -104,7 +104,7 @@ size_t layOut(const ModelView& view, bool single, bool groups, const qv_allocato
   m->contactLevels = contactLevels;
   m->contactCount = view.rigidBody ? orderContactPoints(rest, int(n), m->triangles, int(in.triangleCount), allocator,
                                                         contactVertices, contactLevels) : 0;
-  m->stableStep = lambdaMax > 0 ? 2.0 / std::sqrt(lambdaMax) : INFINITY;
+  m->largestEigenvalue = lambdaMax > 0 ? lambdaMax : 0;
   return c.size();
 }
 

@@ -23,7 +23,7 @@ struct qv_model {
   const double* rotations;      // 3n x r row-major modal rotations, or null
   const double* rigidBody;      // a free object's RIGID_BODY moments (rigid_frame.h), or null
   const double* restStiffness;  // K(0), r x r: linear modal dynamics and modal warping step with it
-  double stableStep;            // 2 / omega_max of K(0): central differences' limit
+  double largestEigenvalue;     // of K(0) (omega_max^2): central differences' limit, qv_instance_stable_time_step
   // A free model's rest surface, which other instances touch in a world (contact.h); null when the
   // model is pinned or its surface is not closed.
   const qv_triangle_mesh* surfaceMesh;

@@ -17,7 +17,7 @@ extern "C" {
 
 #define QV_VERSION_MAJOR 0
 #define QV_VERSION_MINOR 12
-#define QV_VERSION_PATCH 1
+#define QV_VERSION_PATCH 2
 #define QV_VERSION_NUMBER (QV_VERSION_MAJOR * 10000 + QV_VERSION_MINOR * 100 + QV_VERSION_PATCH)
 
 /* The library's version as "major.minor.patch". */
@@ -454,7 +454,9 @@ QV_API void qv_instance_wake(qv_instance* instance);
    impulse is on `instance`, its opposite on `other`). */
 QV_API int qv_world_contacts(const qv_world* world, qv_contact* contacts, int capacity);
 
-/* Largest stable time step of central differences at rest (2 / omega_max), s. */
+/* Largest stable time step of central differences at rest, s: 2 / (c + sqrt(c^2 + omega_max^2)) for
+   the stiffest mode of K(0), whose Rayleigh damping c = rayleigh_alpha + rayleigh_beta omega_max^2
+   is explicit (2 / omega_max undamped; stiffness-proportional damping can lower it tenfold). */
 QV_API double qv_instance_stable_time_step(const qv_instance* instance);
 
 /* Output into caller-owned buffers: deformed positions X + U q (3 floats per vertex; x + R (X - c + U q) in flight), of all
