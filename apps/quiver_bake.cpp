@@ -90,7 +90,9 @@ int main(int argc, char** argv) {
                "slowest stage on large meshes)");
   app.add_flag("--export-npy", s.output.exportNpy, "Also write NAME.eigenvalues.npy, NAME.modes.npy and NAME.U.npy (float64)");
   app.add_flag("--resume", s.resume, "Reuse the stages of NAME.h5.partial (or NAME.h5) whose inputs have not changed");
-  app.add_option("-o,--output", s.output.name, "Output name: writes NAME.qvr, NAME.h5 and NAME.xmf")->required();
+  app.add_option("-o,--output", s.output.name, "Output name: writes NAME.qvr, NAME.h5 and NAME.xmf")
+      ->required()
+      ->transform(app::OutputName({".qvr", ".h5", ".xmf"}));
   app.add_flag("--quiet", quiet, "Print nothing but warnings and errors");
 
   std::vector<char*> ownArgv;

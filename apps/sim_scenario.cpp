@@ -70,7 +70,8 @@ std::string SimOptions::checkScenarioOption(const std::string& name, const std::
 
 void SimOptions::addTo(CLI::App& app) {
   addScenarioTo(app);
-  app.add_option("-o,--output", output, "Write NAME.pvd with NAME_NNNNN.vtu frames and NAME.csv");
+  app.add_option("-o,--output", output, "Write NAME.pvd with NAME_NNNNN.vtu frames and NAME.csv")
+      ->transform(OutputName({".pvd", ".csv"}));
   app.add_option("--every", every, "Write every k-th step")->capture_default_str()->check(Positive);
   app.add_flag("--json", json, "Print one JSON summary");
 }

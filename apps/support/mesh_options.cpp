@@ -92,6 +92,19 @@ const CLI::Validator NonNegative =
     numberWhere([](double x) { return x >= 0 && std::isfinite(x); }, "a number >= 0", "NON-NEGATIVE");
 const CLI::Validator Finite = numberWhere([](double x) { return std::isfinite(x); }, "a finite number", "FINITE");
 
+CLI::Validator OutputName(std::vector<std::string> extensions) {
+  return CLI::Validator(
+      [extensions](std::string& name) {
+        for (const std::string& e : extensions)
+          if (name.size() > e.size() && name.compare(name.size() - e.size(), e.size(), e) == 0) {
+            name.resize(name.size() - e.size());
+            break;
+          }
+        return std::string();
+      },
+      "NAME");
+}
+
 int runTool(const std::string& tool, CLI::App& app, int argc, char** argv, const std::function<int()>& body,
             const ArgumentRewrite& rewrite) {
   std::vector<std::string> args(argv + 1, argv + argc);

@@ -2,6 +2,7 @@
 // Command-line options shared by the tools that read a mesh, so that every tool spells and
 // documents them the same way.
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -46,6 +47,10 @@ extern const CLI::Validator Positive;
 extern const CLI::Validator NonNegative;
 // Any finite number (a vector option checks each of its values).
 extern const CLI::Validator Finite;
+
+// An output NAME the tool extends itself (NAME.qvr, NAME.h5, ...): drops one of `extensions` the
+// user gave, so that "-o model.qvr" writes model.qvr, not model.qvr.qvr.
+CLI::Validator OutputName(std::vector<std::string> extensions);
 
 // Rewrites the command line (without the program name) before it is parsed; may throw.
 using ArgumentRewrite = std::function<std::vector<std::string>(const std::vector<std::string>&)>;

@@ -195,9 +195,13 @@ class QuiverBake(unittest.TestCase):
                     self.assertFalse(os.path.exists(os.path.join(self.dir, "bad.h5")))
 
     def test_more_vectors_than_the_recipe_gives_warn_and_bake_the_largest_r(self):
-        p = bake(1, self.beam, "--modes", "3", "--rank", "10", "-o", os.path.join(self.dir, "fewer"))
+        # "-o NAME.qvr" names the model, as "-o NAME" does (it once wrote fewer.qvr.qvr).
+        p = bake(1, self.beam, "--modes", "3", "--rank", "10", "-o", os.path.join(self.dir, "fewer.qvr"))
         self.assertEqual(p.returncode, 0, p.stderr)
         self.assertIn("r = 9 instead of 10", p.stderr)
+        for extension in (".qvr", ".h5", ".xmf"):
+            self.assertTrue(os.path.exists(os.path.join(self.dir, "fewer" + extension)), extension)
+        self.assertFalse(os.path.exists(os.path.join(self.dir, "fewer.qvr.qvr")))
         p = bake(1, self.beam, "--basis", "svd", "-o", os.path.join(self.dir, "fewer"))
         self.assertNotEqual(p.returncode, 0)
         self.assertIn("svd not in {pca,keep-modes,modes}", p.stderr)

@@ -158,6 +158,9 @@ class QuiverSim(OnTheBakedModel):
         self.assertEqual(len(rows), 41)
         with open(out + ".pvd") as f:
             self.assertEqual(f.read().count("<DataSet"), 4)
+        # "-o NAME.pvd" names the series as "-o NAME" does (it once wrote NAME.pvd.pvd).
+        self.sim("--steps", 2, "-o", out + "2.pvd")
+        self.assertTrue(os.path.exists(out + "2.pvd") and os.path.exists(out + "2.csv"))
         try:
             import meshio
         except ImportError:
