@@ -1,6 +1,7 @@
 // quiver-mesh: inspect, convert and generate tetrahedral meshes.
 #include <iostream>
 #include <map>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -13,6 +14,9 @@ using namespace quiver;
 using nlohmann::ordered_json;
 
 namespace {
+
+// About a gigabyte of mesh in memory.
+constexpr double kMaxBeamTets = 5e7;
 
 ordered_json rangeJson(const Range& r) { return {{"min", r.min}, {"mean", r.mean}, {"max", r.max}}; }
 
@@ -97,7 +101,22 @@ int main(int argc, char** argv) {
     } else if (*convert) {
       writeMeshFile(convertOut, convertMesh.load(tool).mesh);
     } else if (*beam) {
-      writeMeshFile(beamOut, makeBoxMesh({size[0], size[1], size[2]}, {cells[0], cells[1], cells[2]}));
+      for (double length : size)
+        if (length > 1e9) throw std::runtime_error("--size: an edge beyond 1e9 (in metres?)");
+      const double tets = 6.0 * cells[0] * cells[1] * cells[2];
+      if (tets > kMaxBeamTets)
+        throw std::runtime_error("--cells: " + std::to_string(static_cast<long long>(tets)) + " tets; at most " +
+                                 std::to_string(static_cast<long long>(kMaxBeamTets)));
+      const TetMesh mesh = makeBoxMesh({size[0], size[1], size[2]}, {cells[0], cells[1], cells[2]});
+      // Cells far flatter one way than another make tets the bake refuses as degenerate.
+      const double quality = measureQuality(mesh).normalisedVolume.min, least = MeshCheckOptions{}.degenerateTolerance;
+      if (!(quality >= least)) {
+        std::ostringstream message;
+        message << "--size and --cells make cells so flat that their tets are degenerate (normalised volume " << quality
+                << ", below " << least << "): give the cells edges of more alike lengths";
+        throw std::runtime_error(message.str());
+      }
+      writeMeshFile(beamOut, mesh);
     }
     return 0;
   });

@@ -50,6 +50,15 @@ class Beam(unittest.TestCase):
             p = run("beam", *args, "-o", "x.vtu", ok=False)
             self.assertNotEqual(p.returncode, 0, args)
             self.assertTrue(p.stderr.strip(), args)
+        # Once accepted: a mesh of 6e9 tets (6 GB in 16 s before it was stopped), coordinates that
+        # overflowed, and tets the bake refuses as degenerate.
+        for args, message in ((["--cells", "1000,1000,1000"], "6000000000 tets; at most 50000000"),
+                              (["--size", "1,1e308,1"], "--size: an edge beyond 1e9"),
+                              (["--size", "1e-10,1,1"], "their tets are degenerate")):
+            p = run("beam", *args, "-o", "x.vtu", ok=False)
+            self.assertEqual(p.returncode, 1, args)
+            self.assertIn(message, p.stderr)
+            self.assertFalse(os.path.exists("x.vtu"))
 
 
 @unittest.skipIf(meshio is None, "python3-meshio not installed")
