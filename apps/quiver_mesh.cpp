@@ -99,7 +99,9 @@ int main(int argc, char** argv) {
       if (infoFixed.given()) fixed = infoFixed.select(m);
       std::cout << describe(infoMesh.path, m, infoFixed.given() ? &fixed : nullptr).dump(2) << "\n";
     } else if (*convert) {
-      writeMeshFile(convertOut, convertMesh.load(tool).mesh);
+      const CheckedMesh m = convertMesh.load(tool);
+      for (const std::string& dropped : droppedByFormat(convertOut, m.mesh)) std::cerr << tool << ": warning: " << dropped << "\n";
+      writeMeshFile(convertOut, m.mesh);
     } else if (*beam) {
       for (double length : size)
         if (length > 1e9) throw std::runtime_error("--size: an edge beyond 1e9 (in metres?)");

@@ -1,11 +1,28 @@
 #include "formats/mesh/write_mesh.h"
 
 #include <filesystem>
+#include <set>
 
 #include "formats/atomic_file.h"
 #include "common/mesh_error.h"
 
 namespace quiver {
+
+std::vector<std::string> droppedByFormat(const std::string& path, const TetMesh& mesh) {
+  const bool vega = detectMeshFormat(path, "") == MeshFormat::Vega;
+  std::vector<std::string> dropped;
+  if (!vega && !mesh.tetMaterial.empty()) {
+    std::string names;
+    for (const Material& m : mesh.materials) names += (names.empty() ? "" : ", ") + m.name;
+    dropped.push_back(path + " cannot hold materials: the mesh's are dropped (" + names +
+                      "; only .veg holds them, and the bake takes --E, --nu and --density)");
+  }
+  const std::set<int> regions(mesh.tetRegion.begin(), mesh.tetRegion.end());
+  if (vega && mesh.tetMaterial.empty() && regions.size() > 1)
+    dropped.push_back(path + " holds regions only as materials, and the mesh has none: its " +
+                      std::to_string(regions.size()) + " regions are merged into one");
+  return dropped;
+}
 
 void writeMeshFile(const std::string& path, const TetMesh& mesh, const std::vector<PointField>& fields,
                    MeshFormat format) {

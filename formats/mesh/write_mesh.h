@@ -29,6 +29,10 @@ std::string formatMedit(const TetMesh& mesh);  // regions become element referen
 std::string formatVega(const TetMesh& mesh);   // materials and regions as *MATERIAL/*SET/*REGION
 std::pair<std::string, std::string> formatTetGen(const TetMesh& mesh);  // {.node, .ele}, 1-based, region attribute
 
+// What writing `mesh` to `path` (its extension's format) would drop, one sentence each: materials
+// (only .veg holds them), and regions where .veg has no materials to hold them by.
+std::vector<std::string> droppedByFormat(const std::string& path, const TetMesh& mesh);
+
 // Writes `mesh` to `path` in the format its extension names (.vtu .vtk .msh .mesh .veg .node/.ele).
 // Point fields are only kept by .vtu and .vtk; other formats refuse them with MeshError.
 void writeMeshFile(const std::string& path, const TetMesh& mesh, const std::vector<PointField>& fields = {},

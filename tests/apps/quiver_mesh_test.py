@@ -149,6 +149,10 @@ class AgainstMeshio(unittest.TestCase):
                 back = meshio.read(out)
                 np.testing.assert_array_equal(back.points, self.points, err_msg=ext)
                 np.testing.assert_array_equal(back.cells_dict["tetra"], self.tets, err_msg=ext)
+            # .veg holds regions only as materials: converting there says the two regions merge.
+            p = run("convert", src, os.path.join(tmp, "out.veg"))
+            self.assertIn("quiver-mesh: warning: " + os.path.join(tmp, "out.veg") + " holds regions only as materials",
+                          p.stderr)
 
 
 class BadInput(unittest.TestCase):

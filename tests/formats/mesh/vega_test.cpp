@@ -101,6 +101,29 @@ TEST(VegaWriter, RoundTripKeepsMaterials) {
   EXPECT_EQ(back.mesh.materials[0].youngsModulus, 1e5);
 }
 
+// quiver-mesh convert warns of what the target format drops: what it says matches what a round
+// trip through that format loses.
+TEST(VegaWriter, WhatAFormatDropsIsSaid) {
+  const RawMesh r = parseVega(kTwoMaterials, "m.veg");
+  EXPECT_TRUE(droppedByFormat("x.veg", r.mesh).empty());
+  const std::vector<std::string> vtu = droppedByFormat("x.vtu", r.mesh);
+  ASSERT_EQ(vtu.size(), 1u);
+  EXPECT_EQ(vtu[0].rfind("x.vtu cannot hold materials: the mesh's are dropped (soft, hard;", 0), 0u) << vtu[0];
+  EXPECT_TRUE(parseVtu(formatVtu(r.mesh), "x.vtu").mesh.materials.empty());
+
+  TetMesh regions = r.mesh;  // two regions and no material
+  regions.materials.clear();
+  regions.tetMaterial.clear();
+  regions.tetRegion = {3, 7};
+  const std::vector<std::string> veg = droppedByFormat("x.veg", regions);
+  ASSERT_EQ(veg.size(), 1u);
+  EXPECT_NE(veg[0].find("its 2 regions are merged into one"), std::string::npos) << veg[0];
+  const std::vector<int> back = parseVega(formatVega(regions), "x.veg").mesh.tetRegion;
+  EXPECT_TRUE(back.empty() || back[0] == back[1]);
+  EXPECT_TRUE(droppedByFormat("x.msh", regions).empty());
+  EXPECT_EQ(parseGmsh(formatGmsh(regions), "x.msh").mesh.tetRegion, (std::vector<int>{3, 7}));
+}
+
 TEST(BouReader, ParsesOneBasedListsAndRefusesBadNumbers) {
   EXPECT_EQ(parseBou("3,1,\n5 # end\n", "f.bou", 5), (std::vector<int>{2, 0, 4}));
   EXPECT_EQ(parseBou("1 2\n", "f.bou", 5), (std::vector<int>{0, 1}));
