@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <sstream>
 #include <unordered_map>
 
 #include <Eigen/Core>
@@ -115,6 +116,15 @@ CheckedSurface checkSurface(const std::vector<double>& inputPositions, const std
       if (!std::isfinite(c)) fail(where(positions, v) + ": a coordinate is not finite");
       if (std::fabs(c) > 1e9) fail(where(positions, v) + ": a coordinate beyond 1e9 (in metres?): scale the surface first");
     }
+  // The bake works in metres: a surface a micrometre across or less (a file in kilometres? a scale
+  // gone wrong?) failed late and obscurely, in the eigensolver or the export.
+  Vec low = Vec::Constant(INFINITY), high = -low;
+  for (int v = 0; v < n; ++v) low = low.cwiseMin(at(positions, v)), high = high.cwiseMax(at(positions, v));
+  if (n > 0 && !((high - low).maxCoeff() > 1e-6)) {
+    std::ostringstream span;
+    span << (high - low).maxCoeff();
+    fail("the surface spans " + span.str() + " m at most, under a micrometre (not in metres?): scale the surface first");
+  }
   if (input.size() / 3 > (1u << 26)) fail(std::to_string(input.size() / 3) + " triangles: more than 2^26");
   // Degenerate (a repeated corner or no area) and repeated triangles go.
   std::vector<std::array<int, 3>> tris;

@@ -101,6 +101,14 @@ TEST(SurfaceCheck, EveryOtherProblemIsNamedWithItsCount) {
   Soup huge;
   addCube(huge, 0, 1e12);
   EXPECT_NE(errorOf(huge).find("a coordinate beyond 1e9"), std::string::npos);
+  // A surface under a micrometre across once went on to fail in the eigensolver or the export.
+  Soup tiny;
+  addCube(tiny, 0, 1e-30);
+  EXPECT_EQ(errorOf(tiny), "art.obj: the surface spans 1e-30 m at most, under a micrometre (not in metres?): scale the "
+                           "surface first");
+  Soup small;  // a millimetre: no complaint of size
+  addCube(small, 0, 1e-3);
+  EXPECT_EQ(errorOf(small).find("micrometre"), std::string::npos);
   EXPECT_EQ(errorOf(Soup{}), "art.obj: no closed surface: 0 usable triangles");
 }
 
