@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "apps/support/mesh_options.h"
+#include "formats/mesh/read_surface.h"
 #include "precompute/bake.h"
 #include "precompute/blas_core.h"
 
@@ -115,6 +116,11 @@ int main(int argc, char** argv) {
   BakeContext ctx(petsc);
   ctx.quiet = quiet;
   ctx.progress(blas);
+  if (isTetMeshPath(s.mesh.path) && ctx.rank() == 0)
+    for (const char* surfaceOnly : {"--tets", "--edge", "--min-dihedral", "--no-fill-holes"})
+      if (app.count(surfaceOnly) > 0)
+        std::cerr << "quiver-bake: warning: " << surfaceOnly << " applies to a surface input; " << s.mesh.path
+                  << " is a tet mesh: ignored\n";
   std::string error;
   try {
     checkBakeSettings(s);  // before any work

@@ -143,6 +143,9 @@ int renderModel(const std::string& path, const RenderOptions& o) {
   const int width = o.size[0], height = o.size[1];
   if (o.modes > 0) {
     if (o.scenario.hasLoad()) throw std::runtime_error("--modes draws the modes alone: drop the scenario's loads");
+    if (o.modes > model.info().r)
+      std::fprintf(stderr, "quiver render: warning: --modes %d: the model has r = %d, so %d are drawn\n", o.modes,
+                   model.info().r, model.info().r);
     const ModeGrid grid(model, o);
     FrameWriter frames(o.output, 1.0 / kFramesPerOscillation);
     if (!frames.animated()) frames.add(grid.draw(1));

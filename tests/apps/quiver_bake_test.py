@@ -196,9 +196,10 @@ class QuiverBake(unittest.TestCase):
 
     def test_more_vectors_than_the_recipe_gives_warn_and_bake_the_largest_r(self):
         # "-o NAME.qvr" names the model, as "-o NAME" does (it once wrote fewer.qvr.qvr).
-        p = bake(1, self.beam, "--modes", "3", "--rank", "10", "-o", os.path.join(self.dir, "fewer.qvr"))
+        p = bake(1, self.beam, "--modes", "3", "--rank", "10", "--edge", "0.1", "-o", os.path.join(self.dir, "fewer.qvr"))
         self.assertEqual(p.returncode, 0, p.stderr)
         self.assertIn("r = 9 instead of 10", p.stderr)
+        self.assertIn("--edge applies to a surface input;", p.stderr)  # once silently ignored
         for extension in (".qvr", ".h5", ".xmf"):
             self.assertTrue(os.path.exists(os.path.join(self.dir, "fewer" + extension)), extension)
         self.assertFalse(os.path.exists(os.path.join(self.dir, "fewer.qvr.qvr")))

@@ -187,7 +187,8 @@ class QuiverSim(OnTheBakedModel):
             self.assertAlmostEqual(j["instance_step_us_median"], 1e3 * j["frame_ms_median"] / 20)
         for args, message in ((["--instances", 0], "--instances"), (["--instances", 3, "--twist", 10], "--drag or --twist"),
                               (["--instances", 3, "-o", os.path.join(self.tmp.name, "crowd")], "leave out -o"),
-                              (["--instances", 3, "--threads", 0], "--threads")):
+                              (["--instances", 3, "--threads", 0], "--threads"),
+                              (["--instances", 3, "--pile", 4], "need --free")):  # --pile was ignored
             p = self.sim(*args, ok=False)
             self.assertNotEqual(p.returncode, 0)
             self.assertIn(message, p.stderr)
@@ -265,6 +266,8 @@ class QuiverRender(OnTheBakedModel):
         self.assertMoved(twisted, rest)
         self.assertMoved(twisted, pulled)
         modes = self.picture("modes.png", "--size", "300,300", "--modes", "4")
+        _, p = self.render("many.png", "--size", "64,64", "--modes", "1000")  # said nothing of drawing r = 12
+        self.assertIn("--modes 1000: the model has r = 12, so 12 are drawn", p.stderr)
         self.assertFramed(modes)
         basis = self.picture("basis.png", "--size", "300,300", "--modes", "4", "--basis")
         self.assertFramed(basis)
