@@ -214,6 +214,10 @@ Eigen::MatrixXd loadUserBasis(MPI_Comm comm, const std::string& spec, const Chec
     throw std::runtime_error(spec + ": a basis must have shape (3 x " + std::to_string(N) + " vertices, r) = (" +
                              std::to_string(fileRows) + ", r), or (r, " + std::to_string(N) + ", 3)");
   const int64_t r = columns ? shape[1] : shape[0];
+  // A NaN once surfaced as "not linearly independent", from the orthonormalisation.
+  for (size_t i = 0; i < data.size(); ++i)
+    if (!std::isfinite(data[i]))
+      throw std::runtime_error(spec + ": entry " + std::to_string(i) + " (in storage order) is not finite");
   Eigen::MatrixXd full(3 * static_cast<int64_t>(mesh.fileVertex.size()), r);
   for (size_t v = 0; v < mesh.fileVertex.size(); ++v)
     for (int c = 0; c < 3; ++c) {

@@ -281,6 +281,13 @@ class QuiverBake(unittest.TestCase):
                  "-o", out)
         self.assertEqual(p.returncode, 0, p.stderr)
         self.assertIn("was not M-orthonormal", p.stdout + p.stderr)
+        bad = U.copy()
+        bad[5, 1] = np.nan  # once "not linearly independent"
+        np.save(os.path.join(self.dir, "nan.npy"), bad)
+        p = bake(1, self.beam, "--fix", "x<min+1e-9", "--modes", "6", "--basis-from", os.path.join(self.dir, "nan.npy"),
+                 "-o", out)
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn("nan.npy: entry %d (in storage order) is not finite" % (5 * U.shape[1] + 1), p.stderr)
 
     def test_killed_bake_resumes_to_the_same_result(self):
         # Big enough that the derivatives stage is still running when the kill arrives.
