@@ -276,7 +276,7 @@ CheckedSurface checkSurface(const std::vector<double>& inputPositions, const std
   }
   if (apart)
     fail(std::to_string(pieces) + " separate pieces: " + std::to_string(apart) + " outside the largest hold 5% of its volume or more, the first at " +
-         where(positions, firstApart) + "; bake each piece on its own, or join them into one closed surface");
+         where(positions, firstApart) + "; bake each piece on its own, or join them into one closed surface (pieces that overlap: their union)");
   if (inside)
     out.repairs.push_back("set aside " + std::to_string(inside) + " pieces inside the largest (they are carried, not simulated)");
   if (small)
