@@ -141,6 +141,17 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
                                 std::to_string(s.modes) + (in.freeObject() ? " (+ 6 rigid)" : "") + " and --rank " +
                                 std::to_string(s.basis.settings.rank));
   stages.report(describeMesh(in));
+  // A user basis is read before any work: a wrong one once failed only after the modes.
+  Eigen::MatrixXd userBasis;
+  if (!s.basis.userBasis.empty()) {
+    std::string error;
+    try {
+      userBasis = loadUserBasis(ctx.comm(), s.basis.userBasis, in.mesh);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    throwIfAnyRankFailed(error, ctx.comm());
+  }
   const Partition partition = stages.run("partition", [&] { return partitionMesh(in.mesh.mesh, {ctx.size()}); });
   stages.report(std::to_string(ctx.size()) + " part(s), " + std::to_string(partition.cutFaces) + " cut faces");
 
@@ -170,7 +181,7 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
                                     ? basisInputHash(derived ? derivativesHash : modesHash, s.basis.settings)
                                     : userBasisInputHash(in.hash, s.basis.userBasis);
   const ReducedBasis basis = stages.run("basis", [&] {
-    return bakeBasis(ctx, s.basis, in.mesh, system.mass, layout, modes, derivatives, *archive, basisHash);
+    return bakeBasis(ctx, s.basis, userBasis, system.mass, layout, modes, derivatives, *archive, basisHash);
   });
   stages.report(describeBasis(basis));
 

@@ -227,7 +227,7 @@ Eigen::MatrixXd loadUserBasis(MPI_Comm comm, const std::string& spec, const Chec
   return full;
 }
 
-ReducedBasis bakeBasis(const BakeContext& ctx, const BasisRequest& request, const CheckedMesh& mesh, Mat mass,
+ReducedBasis bakeBasis(const BakeContext& ctx, const BasisRequest& request, const Eigen::MatrixXd& user, Mat mass,
                        const DofLayout& layout, const LinearModes& modes, const ModalDerivatives& derivatives,
                        Archive& archive, const std::string& inputHash) {
   ReducedBasis basis;
@@ -237,8 +237,7 @@ ReducedBasis bakeBasis(const BakeContext& ctx, const BasisRequest& request, cons
     source = request.settings.kind == BasisKind::Pca ? "modes+derivatives" : basisKindName(request.settings.kind);
   } else {
     bool wasOrthonormal = true;
-    basis = importBasis(mass, layout, layout.localRowsOf(loadUserBasis(ctx.comm(), request.userBasis, mesh)),
-                        wasOrthonormal);
+    basis = importBasis(mass, layout, layout.localRowsOf(user), wasOrthonormal);
     if (!wasOrthonormal) basis.warning = request.userBasis + " was not M-orthonormal; it was orthonormalised";
     source = request.userBasis;
   }

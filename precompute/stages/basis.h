@@ -56,13 +56,14 @@ ReducedBasis buildBasis(Mat mass, const DofLayout& layout, const LinearModes& mo
                         const ModalDerivatives& derivatives, const BasisSettings& settings);
 
 // The stage as the bake runs it: the recipe from the modes (and derivatives), or the user's basis
-// (`userBasis` not empty: FILE.npy or FILE.h5:/dataset), written to the archive's /basis. Rank 0
-// warns on stderr when r is smaller than asked or a user basis was not M-orthonormal.
+// (`userBasis` not empty: FILE.npy or FILE.h5:/dataset, given loaded as `user`, loadUserBasis()),
+// written to the archive's /basis. Rank 0 warns on stderr when r is smaller than asked or a user
+// basis was not M-orthonormal.
 struct BasisRequest {
   BasisSettings settings;
   std::string userBasis;
 };
-ReducedBasis bakeBasis(const BakeContext& ctx, const BasisRequest& request, const CheckedMesh& mesh, Mat mass,
+ReducedBasis bakeBasis(const BakeContext& ctx, const BasisRequest& request, const Eigen::MatrixXd& user, Mat mass,
                        const DofLayout& layout, const LinearModes& modes, const ModalDerivatives& derivatives,
                        Archive& archive, const std::string& inputHash);
 

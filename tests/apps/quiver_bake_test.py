@@ -168,6 +168,7 @@ class QuiverBake(unittest.TestCase):
         self.assertIn("option -eps_tl was not used", p.stderr)
 
     def test_bad_input_fails_before_work_on_every_rank_with_one_message(self):
+        np.save(os.path.join(self.dir, "wrong_shape.npy"), np.zeros((10, 3)))
         cases = [
             (["--nu", "0.7"], "Poisson ratio nu = 0.7 must lie in (-1, 0.5)"),
             (["--E", "-1"], "Young's modulus"),
@@ -184,6 +185,8 @@ class QuiverBake(unittest.TestCase):
             (["--fix", "x>0.01", "--modes", "5", "--rank", "37"], "the mesh has 36 free DOFs"),  # r above them
             (["--basis-from", os.path.join(self.dir, "none.npy")], "none.npy"),
             (["--basis-from", os.path.join(self.dir, "beam1.h5:/nothing")], "/nothing"),
+            # Read before any work: it once failed only after the modes.
+            (["--basis-from", os.path.join(self.dir, "wrong_shape.npy")], "wrong_shape.npy: a basis must have shape"),
         ]
         for ranks in (1, 2):
             for extra, message in cases:
@@ -193,6 +196,7 @@ class QuiverBake(unittest.TestCase):
                     self.assertIn(message, p.stderr)
                     self.assertEqual(p.stderr.count("quiver-bake: error:"), 1, p.stderr)
                     self.assertFalse(os.path.exists(os.path.join(self.dir, "bad.h5")))
+                    self.assertNotIn("quiver-bake: modes:", p.stdout)
 
     def test_more_vectors_than_the_recipe_gives_warn_and_bake_the_largest_r(self):
         # "-o NAME.qvr" names the model, as "-o NAME" does (it once wrote fewer.qvr.qvr).
