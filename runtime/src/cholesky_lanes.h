@@ -3,6 +3,8 @@
 // SIMD across the group: the Newton matrices of instances stepped together (step_many.h). Alone,
 // an r = 30 factorisation runs along rows of 30 or fewer; across a group every operation is a full
 // vector of lanes.
+#include <cstring>
+
 #include "reduced_polynomial.h"
 
 namespace quiver::rt {
@@ -26,9 +28,29 @@ void choleskyFactorLanes(double* A, int n, bool* ok);
 // it; none while A is null.
 struct LaneFactor {
   static constexpr int kStride = kCholeskyLanes;
+  using Value = double;
   const double* A = nullptr;
   int n = 0, lane = 0;
   const double* row(int i) const { return A + (packedUpperIndex(n, i, i) - static_cast<size_t>(i)) * kStride + lane; }
+  static void load(const double* at, double& value) { value = *at; }
 };
+
+// Four lanes of choleskyFactorLanes()'s factors at once (lanes 4 half to 4 half + 3), as
+// choleskySubstitute() reads them: an entry is the vector of those lanes', and so is each
+// right-hand side's entry (four lanes interleaved), so that the group's systems are solved four at
+// a time, each lane by its own solve's operations. Four, not all eight: where vectors are four
+// doubles wide, GCC moved eight-wide ones through the stack.
+struct LanesFactor {
+  static constexpr int kStride = kCholeskyLanes, kWidth = 4;
+  typedef double Value __attribute__((vector_size(kWidth * sizeof(double))));
+  const double* A;
+  int n, half;
+  const double* row(int i) const {
+    return A + (packedUpperIndex(n, i, i) - static_cast<size_t>(i)) * kStride + kWidth * half;
+  }
+  // By reference: a returned vector's ABI depends on the instruction set it is compiled for.
+  static void load(const double* at, Value& value) { std::memcpy(&value, at, sizeof value); }
+};
+static_assert(kCholeskyLanes == 2 * LanesFactor::kWidth, "a group's lanes are two LanesFactor halves");
 
 } // namespace quiver::rt

@@ -52,31 +52,48 @@ inline bool choleskyFactor(double* A, int n) {
 // A row-major factor as choleskySubstitute() reads it: entry (i, k), k >= i, at row(i)[k * kStride].
 struct DenseFactor {
   static constexpr int kStride = 1;
+  using Value = double;
   const double* U;
   int n;
   const double* row(int i) const { return U + i * n; }
+  static void load(const double* at, double& value) { value = *at; }
 };
 
 // Solves U^T U x = b with the factor U of choleskyFactor() (or of choleskyFactorLanes(), read in
 // place: LaneFactor, cholesky_lanes.h; the same operations in the same order); b is overwritten
-// by x. The second half's dot products run as four interleaved sums: one sum waited on the
-// multiply-add's latency at every term (two fifths of a crowd member's solve).
+// by x. Factor::Value is what one entry is: a double, or a vector of every lane's (LanesFactor:
+// all a group's systems at once, each lane's operations those of its own solve). The second
+// half's dot products run as four interleaved sums: one sum waited on the multiply-add's latency
+// at every term (two fifths of a crowd member's solve).
 template <class Factor>
-inline void choleskySubstitute(const Factor& U, double* b, int n) {
+inline void choleskySubstitute(const Factor& U, typename Factor::Value* b, int n) {
+  using T = typename Factor::Value;
   constexpr int S = Factor::kStride;
+  T u;
   for (int i = 0; i < n; ++i) {  // U^T y = b
     const double* rowI = U.row(i);
-    b[i] /= rowI[i * S];
-    for (int k = i + 1; k < n; ++k) b[k] -= rowI[k * S] * b[i];
+    Factor::load(rowI + i * S, u);
+    b[i] /= u;
+    for (int k = i + 1; k < n; ++k) {
+      Factor::load(rowI + k * S, u);
+      b[k] -= u * b[i];
+    }
   }
   for (int i = n - 1; i >= 0; --i) {  // U x = y
     const double* rowI = U.row(i);
-    double s[4] = {};
+    T s[4] = {};
     int k = i + 1;
     for (; k + 4 <= n; k += 4)
-      for (int m = 0; m < 4; ++m) s[m] += rowI[(k + m) * S] * b[k + m];
-    for (int m = 0; k < n; ++k, ++m) s[m] += rowI[k * S] * b[k];
-    b[i] = (b[i] - ((s[0] + s[1]) + (s[2] + s[3]))) / rowI[i * S];
+      for (int m = 0; m < 4; ++m) {
+        Factor::load(rowI + (k + m) * S, u);
+        s[m] += u * b[k + m];
+      }
+    for (int m = 0; k < n; ++k, ++m) {
+      Factor::load(rowI + k * S, u);
+      s[m] += u * b[k];
+    }
+    Factor::load(rowI + i * S, u);
+    b[i] = (b[i] - ((s[0] + s[1]) + (s[2] + s[3]))) / u;
   }
 }
 

@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "cholesky_lanes.h"
+#include "dense_solve.h"
 #include "dynamics.h"
 #include "simd_dispatch.h"
 #include "integrators/integrator.h"
@@ -111,8 +112,43 @@ QV_HOT double* evaluateTogether(qv_instance* const* members, int count, double* 
   return stiffnessLanes;
 }
 
+// The members' first Newton systems (right-hand sides in their s.work.correction) solved together
+// in the group's factor where a member takes it (takePresetFactor(), as solveNewton() would): four
+// lanes at a time interleaved in `B` (r kLanes doubles, 32-byte aligned), every substitution's
+// operation one vector across them, each lane's those of its own solve (each member alone read its
+// lane with a stride of eight, one latency after another). solved[l]: member l's correction is its
+// solution.
+QV_HOT void solveTogether(qv_instance* const* members, int count, const bool* going, double* B, bool* solved) {
+  constexpr int W = LanesFactor::kWidth;
+  const int r = members[0]->r;
+  const double* A = nullptr;
+  double* rhs[kLanes] = {};  // by the factor's lane
+  for (int l = 0; l < count; ++l) {
+    qv_instance& s = *members[l];
+    solved[l] = false;
+    if (!going[l]) continue;
+    double c1, c2;
+    newmarkNewtonScales(s, c1, c2);
+    const LaneFactor factor = takePresetFactor(s, newtonSystem(s, c1, c2));
+    if (!factor.A) continue;
+    A = factor.A, rhs[factor.lane] = s.work.correction, solved[l] = true;
+  }
+  for (int half = 0; A && half < kLanes / W; ++half) {
+    double* const* x = rhs + W * half;
+    if (!(x[0] || x[1] || x[2] || x[3])) continue;
+    // Lanes no member solves in hold zeros; their results are dropped.
+    for (int k = 0; k < r; ++k)
+      for (int l = 0; l < W; ++l) B[k * W + l] = x[l] ? x[l][k] : 0.0;
+    choleskySubstitute(LanesFactor{A, r, half}, reinterpret_cast<LanesFactor::Value*>(B), r);
+    for (int l = 0; l < W; ++l)
+      if (x[l])
+        for (int k = 0; k < r; ++k) x[l][k] = B[k * W + l];
+  }
+}
+
 // Fixed Newton steps, up to kLanes: one evaluation each, at the state (fixed_newton.h), and its
-// Newton matrix, both together. Members whose step is the minimiser's (newmarkStepMinimized()) are not
+// Newton matrix, both together; then every step up to its first solve, the solves together, and
+// every step's rest. Members whose step is the minimiser's (newmarkStepMinimized()) are not
 // evaluated here.
 void stepNewtonGroup(qv_instance* const* group, const int* index, int count, double* scratch,
                      qv_step_status* statuses) {
@@ -130,9 +166,20 @@ void stepNewtonGroup(qv_instance* const* group, const int* index, int count, dou
     fixed[fixedCount++] = &s;
   }
   if (fixedCount > 0) factoriseGroup(fixed, fixedCount, scales, evaluateTogether(fixed, fixedCount, scratch));
+  NewmarkNewton step[kLanes];
+  qv_step_status status[kLanes];
+  bool going[kLanes], solved[kLanes];
   for (int l = 0; l < count; ++l) {
-    const qv_step_status status = group[l]->finishStep();
-    if (statuses) statuses[index[l]] = status;
+    group[l]->moveFrame();  // as finishStep() would
+    going[l] = beginNewmarkNewton(*group[l], step[l], status[l]);
+  }
+  // The evaluation's scratch is free again: the right-hand sides go there.
+  solveTogether(group, count, going, scratch + pairs(group[0]->r) * kLanes, solved);
+  for (int l = 0; l < count; ++l) {
+    qv_instance& s = *group[l];
+    if (going[l]) status[l] = endNewmarkNewton(s, step[l], solved[l]);
+    status[l] = s.endStep(status[l]);
+    if (statuses) statuses[index[l]] = status[l];
   }
 }
 

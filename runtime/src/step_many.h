@@ -1,8 +1,9 @@
 #pragma once
 // Many instances of one model stepped in one call (qv_instances_step): St.Venant-Kirchhoff Newmark
 // instances are evaluated up to ReducedPolynomial::kLanes at a time (each coefficient read once for
-// them, SIMD across them) and their Newton matrices factorised together; each step otherwise runs
-// as qv_instance_step would run it (docs/architecture.md, "Many instances"). The work is cut into
+// them, SIMD across them) and their Newton matrices factorised together (the fixed Newton steps'
+// first systems solved together too); each step otherwise runs as qv_instance_step would run it
+// (docs/architecture.md, "Many instances"). The work is cut into
 // the caller's jobs; each job owns a slice of the caller's scratch.
 #include "instance.h"
 

@@ -80,6 +80,44 @@ TEST(DenseSolve, CholeskyLanesFactoriseEachLaneAsAloneAndKeepABadLaneToItself) {
   }
 }
 
+// The group's systems solved four lanes at a time (LanesFactor) give each lane the bits its own
+// solve in its lane gives (LaneFactor: the same operations), and solve the system (Eigen).
+TEST(DenseSolve, LanesSolvedTogetherAsEachAlone) {
+  constexpr int L = kCholeskyLanes, W = LanesFactor::kWidth;
+  std::mt19937 rng(4);
+  std::normal_distribution<double> n(0, 1);
+  for (int size : {1, 6, 30}) {
+    std::vector<Eigen::MatrixXd> spd(L);
+    std::vector<double> A(packedUpperIndex(size, size, size) * L);
+    for (int l = 0; l < L; ++l) {
+      Eigen::MatrixXd B(size, size);
+      for (auto& x : B.reshaped()) x = n(rng);
+      spd[l] = B * B.transpose() + 0.1 * Eigen::MatrixXd::Identity(size, size);
+      for (int i = 0; i < size; ++i)
+        for (int j = i; j < size; ++j) A[packedUpperIndex(size, i, j) * L + l] = spd[l](i, j);
+    }
+    bool ok[L];
+    choleskyFactorLanes(A.data(), size, ok);
+    std::vector<Eigen::VectorXd> rhs(L, Eigen::VectorXd(size));
+    for (auto& b : rhs)
+      for (auto& x : b) x = n(rng);
+    for (int half = 0; half < L / W; ++half) {
+      std::vector<LanesFactor::Value> together(size);
+      for (int k = 0; k < size; ++k)
+        for (int w = 0; w < W; ++w) together[k][w] = rhs[W * half + w](k);
+      choleskySubstitute(LanesFactor{A.data(), size, half}, together.data(), size);
+      for (int w = 0; w < W; ++w) {
+        const int l = W * half + w;
+        ASSERT_TRUE(ok[l]);
+        Eigen::VectorXd alone = rhs[l];
+        choleskySubstitute(LaneFactor{A.data(), size, l}, alone.data(), size);
+        for (int k = 0; k < size; ++k) EXPECT_EQ(together[k][w], alone(k)) << size << " lane " << l << " entry " << k;
+        EXPECT_LT((alone - spd[l].llt().solve(rhs[l])).norm(), 1e-10 * alone.norm()) << size << " lane " << l;
+      }
+    }
+  }
+}
+
 TEST(DenseSolve, SymmetricEigenAgainstEigen) {
   std::mt19937 rng(3);
   std::normal_distribution<double> n(0, 1);

@@ -39,38 +39,68 @@ qv_step_status minimizing(qv_instance& s) {
 
 } // namespace
 
-qv_step_status stepImplicitNewmark(qv_instance& s) {
-  if (s.config.solver == QV_SOLVER_MINIMIZE) return minimizing(s);
-  double budget;
-  const double* J = beginFixedNewton(s, budget);
-  // Soft contacts pin the deformation where they hold it, and the trapezoidal rule then flips its
-  // velocity there every step (v' = 2 (q' - q) / h - v): fixed steps rang against a resting bar and,
-  // at one or two iterations, fed it until it flew off. The minimiser's energy budget bounds them.
-  if (newmarkStepMinimized(s)) return minimizedInstead(s, minimizing, true);
+namespace {
+
+// Iteration `it` of the fixed Newton step up to its solve: the end that s.end.a puts, the forces
+// there (evaluated after the first iteration, which is linearised at q), and the right-hand side
+// in s.work.correction. Returns J.
+const double* newtonRightHandSide(qv_instance& s, int it, const double* J) {
   const double h = s.config.time_step, beta = kNewmarkBeta, gamma = kNewmarkGamma;
   const int r = s.r;
   const double *q = s.q, *v = s.v, *a = s.a;
+  for (int i = 0; i < r; ++i) {
+    s.end.q[i] = q[i] + h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * s.end.a[i]);
+    s.end.v[i] = v[i] + h * ((1 - gamma) * a[i] + gamma * s.end.a[i]);
+  }
+  if (it > 0) J = evaluateForces(s, s.end.q);
+  dampingForces(s, s.end.v, s.work.damping);
+  for (int i = 0; i < r; ++i)
+    s.work.correction[i] = -(s.end.a[i] + s.work.damping[i] + s.work.force[i] - s.loads.external(i));
+  return J;
+}
+
+} // namespace
+
+bool beginNewmarkNewton(qv_instance& s, NewmarkNewton& step, qv_step_status& status) {
+  step.J = beginFixedNewton(s, step.budget);
+  // Soft contacts pin the deformation where they hold it, and the trapezoidal rule then flips its
+  // velocity there every step (v' = 2 (q' - q) / h - v): fixed steps rang against a resting bar and,
+  // at one or two iterations, fed it until it flew off. The minimiser's energy budget bounds them.
+  if (newmarkStepMinimized(s)) {
+    status = minimizedInstead(s, minimizing, true);
+    return false;
+  }
+  const double h = s.config.time_step, beta = kNewmarkBeta;
   // The first iteration at q itself: the end-of-step acceleration that puts the end there.
-  for (int i = 0; i < r; ++i) s.end.a[i] = -(v[i] / (beta * h) + (0.5 - beta) / beta * a[i]);
+  for (int i = 0; i < s.r; ++i) s.end.a[i] = -(s.v[i] / (beta * h) + (0.5 - beta) / beta * s.a[i]);
+  step.J = newtonRightHandSide(s, 0, step.J);
+  return true;
+}
+
+qv_step_status endNewmarkNewton(qv_instance& s, const NewmarkNewton& step, bool solved) {
+  const double h = s.config.time_step, beta = kNewmarkBeta, gamma = kNewmarkGamma;
+  const int r = s.r;
+  const double *q = s.q, *v = s.v, *a = s.a;
+  const double* J = step.J;
+  double c1, c2;
+  newmarkNewtonScales(s, c1, c2);
   for (int it = 0; it < s.config.newton_iterations; ++it, ++s.lastStep.newton_iterations) {
-    for (int i = 0; i < r; ++i) {
-      s.end.q[i] = q[i] + h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * s.end.a[i]);
-      s.end.v[i] = v[i] + h * ((1 - gamma) * a[i] + gamma * s.end.a[i]);
-    }
-    if (it > 0) J = evaluateForces(s, s.end.q);
-    dampingForces(s, s.end.v, s.work.damping);
-    for (int i = 0; i < r; ++i)
-      s.work.correction[i] = -(s.end.a[i] + s.work.damping[i] + s.work.force[i] - s.loads.external(i));
-    double c1, c2;
-    newmarkNewtonScales(s, c1, c2);
-    if (!solveNewton(s, J, c1, c2)) return minimizedInstead(s, minimizing, it == 0);
+    if (it > 0) J = newtonRightHandSide(s, it, J);
+    if (!(it == 0 && solved) && !solveNewton(s, J, c1, c2)) return minimizedInstead(s, minimizing, it == 0);
     for (int i = 0; i < r; ++i) s.end.a[i] += s.work.correction[i];
   }
   for (int i = 0; i < r; ++i) {
     s.end.q[i] = q[i] + (h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * s.end.a[i]));
     s.end.v[i] = v[i] + h * ((1 - gamma) * a[i] + gamma * s.end.a[i]);
   }
-  return endFixedNewton(s, budget, minimizing);
+  return endFixedNewton(s, step.budget, minimizing);
+}
+
+qv_step_status stepImplicitNewmark(qv_instance& s) {
+  if (s.config.solver == QV_SOLVER_MINIMIZE) return minimizing(s);
+  NewmarkNewton step;
+  qv_step_status status;
+  return beginNewmarkNewton(s, step, status) ? endNewmarkNewton(s, step, false) : status;
 }
 
 } // namespace quiver::rt

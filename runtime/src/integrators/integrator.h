@@ -25,6 +25,16 @@ struct SolverEntry {
 extern const SolverEntry kSolvers[QV_SOLVER_COUNT];
 
 qv_step_status stepImplicitNewmark(qv_instance& s);
+// Its fixed Newton step in two parts, so that a group solves its members' first systems together
+// (step_many.cpp): up to the first solve, its right-hand side in s.work.correction (false where the
+// step went to the minimiser instead, with its status in `status`); then the rest, the first
+// system already solved (`solved`: the correction in s.work.correction) or not.
+struct NewmarkNewton {
+  double budget;
+  const double* J;
+};
+bool beginNewmarkNewton(qv_instance& s, NewmarkNewton& step, qv_step_status& status);
+qv_step_status endNewmarkNewton(qv_instance& s, const NewmarkNewton& step, bool solved);
 // Its minimising solver's step in parts (a group runs the middle, step_many.h): qt, v0 and the
 // guess; then, after the minimisation, the end of the step as its minimum, with Newmark's own
 // acceleration a' = 4/h^2 (x - qt) (the equations of motion's at convergence; bounded by the
