@@ -28,7 +28,7 @@ QV_HOT void choleskyFactorLanes(double* A, int n, bool* ok) {
   const auto row = [&](int i) { return A + (packedUpperIndex(n, i, i) - static_cast<size_t>(i)) * L; };
   for (int l = 0; l < L; ++l) ok[l] = true;
   // choleskyFactor()'s panels of four pivots: one load and store of each entry below a panel for
-  // its four updates (one per pivot, stores bound the sweeps: about a fifth of a group's step).
+  // its four updates (a sweep per pivot stored each entry once per pivot: the stores bound it).
   for (int j = 0; j < n; j += B) {
     const int end = j + B < n ? j + B : n;
     for (int t = j; t < end; ++t) {

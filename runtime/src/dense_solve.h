@@ -61,8 +61,8 @@ struct DenseFactor {
 
 // Solves U^T U x = b with the factor U of choleskyFactor() (or of choleskyFactorLanes(), read in
 // place: LaneFactor, cholesky_lanes.h; the same operations in the same order); b is overwritten
-// by x. Factor::Value is what one entry is: a double, or a vector of every lane's (LanesFactor:
-// all a group's systems at once, each lane's operations those of its own solve). The second
+// by x. Factor::Value is what one entry is: a double, or a vector of four lanes' (LanesFactor: a
+// group's systems four at a time, each lane's operations those of its own solve). The second
 // half's dot products run as four interleaved sums: one sum waited on the multiply-add's latency
 // at every term (two fifths of a crowd member's solve).
 template <class Factor>
