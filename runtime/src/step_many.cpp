@@ -114,7 +114,7 @@ QV_HOT double* evaluateTogether(qv_instance* const* members, int count, double* 
 
 // The members' first Newton systems (right-hand sides in their s.work.correction) solved together
 // in the group's factor where a member takes it (takePresetFactor(), as solveNewton() would): four
-// lanes at a time interleaved in `B` (r kLanes doubles, 32-byte aligned), every substitution's
+// lanes at a time interleaved in `B` (r times four doubles, 32-byte aligned), every substitution's
 // operation one vector across them, each lane's those of its own solve (each member alone read its
 // lane with a stride of eight, one latency after another). solved[l]: member l's correction is its
 // solution.
@@ -135,7 +135,7 @@ QV_HOT void solveTogether(qv_instance* const* members, int count, const bool* go
   }
   for (int half = 0; A && half < kLanes / W; ++half) {
     double* const* x = rhs + W * half;
-    if (!(x[0] || x[1] || x[2] || x[3])) continue;
+    if (std::none_of(x, x + W, [](const double* lane) { return lane != nullptr; })) continue;
     // Lanes no member solves in hold zeros; their results are dropped.
     for (int k = 0; k < r; ++k)
       for (int l = 0; l < W; ++l) B[k * W + l] = x[l] ? x[l][k] : 0.0;
