@@ -18,8 +18,12 @@ void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales&
                                  scales.dampingStiffness * D[i * r + j] + (i == j ? scales.identity : 0.0);
 }
 
-void dampWithStiffness(const qv_instance& s, const double* K, double* D) {
+void dampWithStiffness(const qv_instance& s, const double* K, double* D, bool definite) {
   const int r = s.r;
+  if (definite) {  // the ladder's first rung, which would succeed
+    if (D != K) std::memcpy(D, K, sizeof(double) * r * r);
+    return;
+  }
   const double* K0 = s.model->restStiffness;
   bool finite = true;
   for (int i = 0; i < r * r; ++i) finite = finite && std::isfinite(K[i]);
@@ -61,16 +65,17 @@ LaneFactor takePresetFactor(qv_instance& s, const SystemScales& scales) {
   return factor;
 }
 
-void elasticityAt(qv_instance& s, const double* q, double* energy, double* force) {
+bool elasticityAt(qv_instance& s, const double* q, double* energy, double* force) {
   const bool preset = s.work.presetValid && std::memcmp(q, s.work.presetAt, sizeof(double) * s.r) == 0;
   s.work.presetValid = false;  // only ever the next evaluation: the one after is elsewhere
   if (!preset) s.work.presetFactor = LaneFactor{};
   if (preset) {
     std::memcpy(force, s.work.presetForce, sizeof(double) * s.r);
     if (energy) *energy = s.work.presetEnergy;
-    return;
+    return s.work.presetDefinite;
   }
   evaluateElasticity(*s.model, s.config.elasticity, q, energy, force, s.work.stiffness, s.work.polynomialScratch);
+  return false;
 }
 
 const double* evaluateForces(qv_instance& s, const double* q) {

@@ -10,8 +10,9 @@
 namespace quiver::rt {
 
 // E(q) (when `energy` is not null), R(q) into `force` and K(q) into s.work.stiffness: the
-// group's preset when it was evaluated at exactly q (step_many.h), else evaluated now.
-void elasticityAt(qv_instance& s, const double* q, double* energy, double* force);
+// group's preset when it was evaluated at exactly q (step_many.h), else evaluated now. Returns
+// whether K(q) is known to be positive definite (the group's presetDefinite).
+bool elasticityAt(qv_instance& s, const double* q, double* energy, double* force);
 
 // Fills s.work.force = R(q) + S(q) and s.work.stiffness = K(q); returns J.
 const double* evaluateForces(qv_instance& s, const double* q);
@@ -35,8 +36,9 @@ inline SystemScales newtonSystem(const qv_instance& s, double c1, double c2) {
 // D = K + mu I into `D` (may be K), K symmetric (r x r), mu the smallest of 0 and a ladder from
 // 1e-6 of K's largest diagonal entry, each rung 4x the last (40 at most), that makes D positive
 // definite (a negative damping would add energy). From K(0) where K is not finite (the step resets
-// anyway); always positive definite, so that a snapshot of it restores.
-void dampWithStiffness(const qv_instance& s, const double* K, double* D);
+// anyway); always positive definite, so that a snapshot of it restores. `definite`: K is known to be
+// positive definite as choleskyFactor() judges (mu = 0, no factorisation).
+void dampWithStiffness(const qv_instance& s, const double* K, double* D, bool definite = false);
 
 // The matrix's upper triangle (all Cholesky reads) into s.work.system.
 void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales& scales);

@@ -50,6 +50,9 @@ struct StepBuffers {
   double* presetForce = nullptr;
   double presetEnergy = 0;
   bool presetValid = false;
+  // Whether the group found that K(q) positive definite, as choleskyFactor() judges (a minimising
+  // step's damping at its end takes it as it is: dampWithStiffness()).
+  bool presetDefinite = false;
   // The group also factorises the matrix the step will solve with at that point (the system with
   // presetScales), in its own scratch; the solver takes it right after the preset
   // (takePresetFactor(), dynamics.h) instead of filling and factorising its own. Untaken (the

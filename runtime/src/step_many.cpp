@@ -108,8 +108,22 @@ QV_HOT double* evaluateTogether(qv_instance* const* members, int count, double* 
   for (int l = 0; l < count; ++l) {
     members[l]->work.presetEnergy = energy[l];
     members[l]->work.presetValid = true;
+    members[l]->work.presetDefinite = false;
   }
   return stiffnessLanes;
+}
+
+// Which of the group's K (as evaluateTogether() leaves them, in `K`) are positive definite, by
+// their Cholesky factorisations together in `scratch` (the pairs times kLanes doubles): a
+// minimising step that ends at its point damps the next with K itself then (dampWithStiffness()),
+// which alone factorised K once more, a ninth of a crowd's frame at r = 30. The factorisation's
+// operations are choleskyFactor()'s, so the verdict is that of the one it saves.
+void markDefinite(qv_instance* const* members, int count, const double* K, double* scratch) {
+  const int r = members[0]->r;
+  std::memcpy(scratch, K, sizeof(double) * pairs(r) * kLanes);
+  bool ok[kLanes];
+  choleskyFactorLanes(scratch, r, ok);
+  for (int l = 0; l < count; ++l) members[l]->work.presetDefinite = ok[l];
 }
 
 // The members' first Newton systems (right-hand sides in their s.work.correction) solved together
@@ -211,7 +225,10 @@ void stepMinimizingTogether(qv_instance* const* instances, Next next, double* sc
     // Each point's Newton matrix too, for the direction the step takes from it if it goes on.
     SystemScales scales[kLanes];
     for (int l = 0; l < active; ++l) scales[l] = minimizerSystem(*member[l], predictor[l]);
-    factoriseGroup(member, active, scales, evaluateTogether(member, active, scratch));
+    double* K = evaluateTogether(member, active, scratch);
+    // The evaluation's scratch is free again.
+    markDefinite(member, active, K, scratch + pairs(member[0]->r) * kLanes);
+    factoriseGroup(member, active, scales, K);
     for (int l = 0; l < active; ++l) task[l].resume();
     for (int l = 0; l < active;) {
       if (task[l].pending()) {

@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "free_bar.h"
+#include "runtime/src/dense_solve.h"
+#include "runtime/src/dynamics.h"
 #include "runtime/src/instance.h"
 #include "runtime/src/model.h"
 #include "runtime_fixture.h"
@@ -293,6 +295,43 @@ TEST(StepMany, NewtonMatricesFactorisedInGroupsAgreeWithEachInstanceOwn) {
     std::printf("%s: %d of %d steps indefinite, %llu group factors taken, %d instances with steps the minimiser took\n",
                 what.c_str(), indefinite, steps * count, taken, rescued);
   }
+}
+
+TEST(StepMany, MinimisingStepsDampTheNextAsTheirOwnLadderWould) {
+  // A minimising step damps the next with K at its end, shifted to positive definite where it is
+  // not (dampWithStiffness()); in a group, whether K is positive definite as it stands is the
+  // group's Cholesky verdict, lane by lane (step_many.cpp). Bars pushed along their length, each
+  // by its own force, some past buckling so that K at some ends is indefinite: each D must be the
+  // one the ladder gives from the end's K alone.
+  quiver::test::TestModel m;
+  ASSERT_NE(m.model, nullptr);
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  ASSERT_EQ(config.solver, QV_SOLVER_MINIMIZE);
+  const int count = 16, r = m.info.r;
+  Crowd crowd(m, config, count);
+  size_t bytes = 0;
+  Scratch scratch = scratchFor(m.model, 1, bytes);
+  int definite = 0, indefinite = 0;
+  const double push0 = 500;  // N: past buckling for some bars, at some steps
+  for (int step = 0; step < 60; ++step) {
+    for (int i = 0; i < count; ++i) {
+      const double push[3] = {-push0 * (0.2 + 0.1 * i), 0.01 * (i % 4), 0.0};
+      qv_instance_add_vertex_force(crowd.instances[i], crowd.tip, push);
+    }
+    ASSERT_EQ(qv_instances_step(crowd.instances.data(), count, nullptr, scratch.get(), bytes, nullptr), QV_OK);
+    for (int i = 0; i < count; ++i) {
+      qv_instance& s = *crowd.instances[i];
+      const std::vector<double> K(s.work.stiffness, s.work.stiffness + r * r);
+      std::vector<double> D(K.size()), factor = K;
+      quiver::rt::dampWithStiffness(s, K.data(), D.data());
+      ASSERT_EQ(D, std::vector<double>(s.dampingStiffness, s.dampingStiffness + r * r)) << "instance " << i << " step " << step;
+      (quiver::rt::choleskyFactor(factor.data(), r) ? definite : indefinite)++;
+    }
+  }
+  std::printf("%d ends with K positive definite, %d not\n", definite, indefinite);
+  EXPECT_GT(definite, 0);
+  EXPECT_GT(indefinite, 0);
 }
 
 // Free bars thrown spinning onto a plane, each its own way, twice: `batched` stepped together,

@@ -30,7 +30,7 @@ public:
   PhiPoint evaluate(const double* x, double* elastic) {
     PhiPoint pt;
     double E = 0, S = 0;
-    elasticityAt(s_, x, &E, s_.work.force);
+    pt.definite = elasticityAt(s_, x, &E, s_.work.force);
     pt.jacobian = s_.loads.addStateForces(x, s_.work.force, &S);
     double inertia = 0, external = 0, damping = 0, inertiaNorm = 0, forceNorm = 0, externalNorm = 0, dampingNorm = 0;
     for (int i = 0; i < r_; ++i) velocity_[i] = v0_[i] + p_.s * (x[i] - qt_[i]);
@@ -246,10 +246,10 @@ void MinimizeTask::finish() {
   // A step held back forfeits the slack: what it removed is not to be won back.
   s.energySlack = s.lastStep.held_back ? 0.0 : std::fmax(0.0, budget_ - stepEnergy(s, s.end.q, s.end.v, elastic_));
   s.elasticEnergyAtState = elastic_;
-  // The next step damps with K at this end: the last evaluation's, unless the budget moved x.
+  // The next step damps with K at this end: the last evaluation's (at_'s), unless the budget moved x.
   if (s.lastStep.held_back)
     evaluateElasticity(*s.model, s.config.elasticity, s.end.q, nullptr, s.work.force, s.work.stiffness, s.work.polynomialScratch);
-  dampWithStiffness(s, s.work.stiffness, s.dampingStiffness);
+  dampWithStiffness(s, s.work.stiffness, s.dampingStiffness, at_.definite && !s.lastStep.held_back);
   phase_ = Phase::Done;
 }
 

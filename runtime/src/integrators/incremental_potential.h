@@ -53,10 +53,12 @@ inline int maxIterations(const qv_instance& s) {
   return s.config.solver == QV_SOLVER_MINIMIZE ? s.config.newton_iterations : kMinimizerIterations;
 }
 
-// Phi at one iterate, the force scale of its convergence test and the state forces' Jacobian.
+// Phi at one iterate, the force scale of its convergence test and the state forces' Jacobian, and
+// whether K there is known to be positive definite (elasticityAt(), dynamics.h).
 struct PhiPoint {
   double phi = 0, scale = 0;
   const double* jacobian = nullptr;
+  bool definite = false;
 };
 
 // One minimising step in parts between its evaluations, so that a group (step_many.h) can
