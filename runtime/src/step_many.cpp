@@ -126,27 +126,18 @@ void markDefinite(qv_instance* const* members, int count, const double* K, doubl
   for (int l = 0; l < count; ++l) members[l]->work.presetDefinite = ok[l];
 }
 
-// The members' first Newton systems (right-hand sides in their s.work.correction) solved together
-// in the group's factor where a member takes it (takePresetFactor(), as solveNewton() would): four
-// lanes at a time interleaved in `B` (r times four doubles, 32-byte aligned), every substitution's
-// operation one vector across them, each lane's those of its own solve (each member alone read its
-// lane with a stride of eight, one latency after another). solved[l]: member l's correction is its
-// solution.
-QV_HOT void solveTogether(qv_instance* const* members, int count, const bool* going, double* B, bool* solved) {
+// The members' systems solved together where they take lanes of one group factor (a null factor:
+// not solved here): the right-hand sides in their s.work.correction, four lanes at a time
+// interleaved in `B` (r times four doubles, 32-byte aligned), every substitution's operation one
+// vector across them, each lane's those of its own solve (each member alone read its lane with a
+// stride of eight, one latency after another). The solutions replace the right-hand sides.
+QV_HOT void solveTogether(qv_instance* const* members, const LaneFactor* factors, int count, double* B) {
   constexpr int W = LanesFactor::kWidth;
   const int r = members[0]->r;
   const double* A = nullptr;
   double* rhs[kLanes] = {};  // by the factor's lane
-  for (int l = 0; l < count; ++l) {
-    qv_instance& s = *members[l];
-    solved[l] = false;
-    if (!going[l]) continue;
-    double c1, c2;
-    newmarkNewtonScales(s, c1, c2);
-    const LaneFactor factor = takePresetFactor(s, newtonSystem(s, c1, c2));
-    if (!factor.A) continue;
-    A = factor.A, rhs[factor.lane] = s.work.correction, solved[l] = true;
-  }
+  for (int l = 0; l < count; ++l)
+    if (factors[l].A) A = factors[l].A, rhs[factors[l].lane] = members[l]->work.correction;
   for (int half = 0; A && half < kLanes / W; ++half) {
     double* const* x = rhs + W * half;
     if (std::none_of(x, x + W, [](const double* lane) { return lane != nullptr; })) continue;
@@ -182,16 +173,21 @@ void stepNewtonGroup(qv_instance* const* group, const int* index, int count, dou
   if (fixedCount > 0) factoriseGroup(fixed, fixedCount, scales, evaluateTogether(fixed, fixedCount, scratch));
   NewmarkNewton step[kLanes];
   qv_step_status status[kLanes];
-  bool going[kLanes], solved[kLanes];
-  for (int l = 0; l < count; ++l) {
-    group[l]->moveFrame();  // as finishStep() would
-    going[l] = beginNewmarkNewton(*group[l], step[l], status[l]);
-  }
-  // The evaluation's scratch is free again: the right-hand sides go there.
-  solveTogether(group, count, going, scratch + pairs(group[0]->r) * kLanes, solved);
+  bool going[kLanes];
+  LaneFactor factor[kLanes];  // where the first system is solved together: as solveNewton() takes it
   for (int l = 0; l < count; ++l) {
     qv_instance& s = *group[l];
-    if (going[l]) status[l] = endNewmarkNewton(s, step[l], solved[l]);
+    s.moveFrame();  // as finishStep() would
+    going[l] = beginNewmarkNewton(s, step[l], status[l]);
+    double c1, c2;
+    newmarkNewtonScales(s, c1, c2);
+    factor[l] = going[l] ? takePresetFactor(s, newtonSystem(s, c1, c2)) : LaneFactor{};
+  }
+  // The evaluation's scratch is free again: the right-hand sides go there.
+  solveTogether(group, factor, count, scratch + pairs(group[0]->r) * kLanes);
+  for (int l = 0; l < count; ++l) {
+    qv_instance& s = *group[l];
+    if (going[l]) status[l] = endNewmarkNewton(s, step[l], factor[l].A != nullptr);
     status[l] = s.endStep(status[l]);
     if (statuses) statuses[index[l]] = status[l];
   }
@@ -230,6 +226,12 @@ void stepMinimizingTogether(qv_instance* const* instances, Next next, double* sc
     markDefinite(member, active, K, scratch + pairs(member[0]->r) * kLanes);
     factoriseGroup(member, active, scales, K);
     for (int l = 0; l < active; ++l) task[l].resume();
+    // The Newton directions the steps take from there, solved together.
+    LaneFactor factor[kLanes];
+    for (int l = 0; l < active; ++l) factor[l] = task[l].awaitedSolve();
+    solveTogether(member, factor, active, scratch + pairs(member[0]->r) * kLanes);
+    for (int l = 0; l < active; ++l)
+      if (factor[l].A) task[l].solved(), task[l].resume();
     for (int l = 0; l < active;) {
       if (task[l].pending()) {
         ++l;

@@ -52,15 +52,11 @@ public:
     return pt;
   }
 
-  // Newton direction into s.work.correction: (H + mu I) d = -g, mu the smallest of 0 and a growing
-  // ladder that makes the Cholesky factorisation succeed. Returns whether a shift was needed.
+  // Newton direction into s.work.correction, which holds -g: (H + mu I) d = -g, mu the smallest of
+  // 0 and a growing ladder that makes the Cholesky factorisation succeed. Returns whether a shift
+  // was needed.
   bool direction(const double* jacobian, bool& failed) {
     SystemScales scales = minimizerSystem(s_, p_);
-    for (int i = 0; i < r_; ++i) s_.work.correction[i] = -s_.work.gradient[i];
-    if (const LaneFactor factor = takePresetFactor(s_, scales); factor.A) {
-      choleskySubstitute(factor, s_.work.correction, r_);
-      return false;
-    }
     const double diagonal = scales.identity;
     double largest = 0;
     for (int i = 0; i < r_; ++i)
@@ -198,6 +194,11 @@ void MinimizeTask::resume() {
       point_ = s.end.q;
       return;
     }
+    case Phase::Solve:
+      if (factor_.A) choleskySubstitute(factor_, s.work.correction, r);
+      factor_ = LaneFactor{};
+      step();
+      return;
     case Phase::Restore:
       at_ = minimizer.evaluate(s.end.q, &elastic_);
       finish();
@@ -223,10 +224,22 @@ void MinimizeTask::iterate() {
     return finish();
   }
   if (iteration_ == maxIterations(s)) return finish();
+  for (int i = 0; i < r; ++i) s.work.correction[i] = -s.work.gradient[i];
+  factor_ = takePresetFactor(s, minimizerSystem(s, p_));
+  if (factor_.A) {
+    phase_ = Phase::Solve;
+    return;
+  }
   bool failed = false;
   if (Minimizer(s, p_).direction(at_.jacobian, failed)) status_ = QV_STEP_INDEFINITE;
   if (failed) return finish();
-  ++report.newton_iterations;
+  step();
+}
+
+void MinimizeTask::step() {
+  qv_instance& s = *s_;
+  const int r = s.r;
+  ++s.lastStep.newton_iterations;
   slope_ = dot(s.work.gradient, s.work.correction, r);  // < 0: a descent direction
   // Backtracking: the first step length that lowers Phi enough (Armijo), or, near the minimum
   // where Phi's change drowns in its rounding, one that keeps Phi within rounding and lowers the

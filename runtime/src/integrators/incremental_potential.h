@@ -65,18 +65,24 @@ struct PhiPoint {
 // evaluate its members' points together: begin(), then, while pending() names a point, resume()
 // (which evaluates there, or takes the group's preset evaluation of exactly that point) until
 // pending() is null, then status(). Plain data: a group keeps a few and moves them between lanes.
+// A Newton direction in the group's factor is a part of its own, between two resume() calls: its
+// right-hand side is in s.work.correction and awaitedSolve() names the factor; the group may solve
+// it there and call solved(), else the next resume() solves it.
 class MinimizeTask {
 public:
   // From the guess in s.end.q, with qt in s.work.predictor and v0 in s.work.predictorVelocity.
   void begin(qv_instance& s, const StepPredictor& predictor);
   const double* pending() const { return phase_ == Phase::Done ? nullptr : point_; }
   void resume();
+  LaneFactor awaitedSolve() const { return phase_ == Phase::Solve ? factor_ : LaneFactor{}; }
+  void solved() { factor_ = LaneFactor{}; }
   // Once done: s.end.q is x and s.end.v is v(x) after the energy budget.
   qv_step_status status() const { return status_; }
 
 private:
-  enum class Phase { First, Trial, Restore, Done };
-  void iterate();   // at an accepted iterate: stop, or a Newton direction and its first trial point
+  enum class Phase { First, Solve, Trial, Restore, Done };
+  void iterate();   // at an accepted iterate: stop, or a Newton direction
+  void step();      // along the direction in s.work.correction: its first trial point
   void finish();    // the energy budget
   qv_instance* s_ = nullptr;
   StepPredictor p_{};
@@ -85,6 +91,7 @@ private:
   int iteration_ = 0, cut_ = 0;
   double budget_ = 0, elastic_ = 0, trialElastic_ = 0, gradient_ = 0, slope_ = 0, roundoff_ = 0, length_ = 0;
   PhiPoint at_, trial_;
+  LaneFactor factor_;  // Phase::Solve: the group's factor the direction is solved in, unless solved
   qv_step_status status_ = QV_STEP_OK;
 };
 
