@@ -2,8 +2,11 @@
 
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
+#include <sstream>
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -55,7 +58,46 @@ const aiScene* postProcess(Assimp::Importer& importer, const aiScene* imported, 
   return importer.ApplyPostProcessing(kSteps);
 }
 
-SurfaceMesh fromScene(const aiScene* scene, const Assimp::Importer& importer, const std::string& path) {
+std::string lower(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return text;
+}
+std::string lowerExtension(const std::string& path) { return lower(std::filesystem::path(path).extension().string()); }
+
+// The file behind a scene: its name, and where an OBJ's text can be read again (bytes in memory,
+// or null: the file at `path`).
+struct Source {
+  const std::string& path;
+  bool obj;
+  const void* data = nullptr;
+  size_t size = 0;
+};
+
+// "PATH:LINE: vertex N: ..." for the first "v" record of an OBJ with a coordinate that is not
+// finite, or empty: Assimp numbers its faces' corners, which name no line of the file.
+std::string nonFiniteObjVertex(const Source& source) {
+  std::ifstream file;
+  std::istringstream bytes;
+  if (source.data)
+    bytes.str(std::string(static_cast<const char*>(source.data), source.size));
+  else
+    file.open(source.path, std::ios::binary);
+  std::istream& in = source.data ? static_cast<std::istream&>(bytes) : file;
+  std::string line, tag, token;
+  for (long number = 1, vertex = 0; std::getline(in, line); ++number) {
+    std::istringstream fields(line);
+    if (!(fields >> tag) || tag != "v") continue;
+    ++vertex;
+    for (int c = 0; c < 3 && fields >> token; ++c)
+      if (!std::isfinite(std::strtod(token.c_str(), nullptr)))
+        return source.path + ":" + std::to_string(number) + ": vertex " + std::to_string(vertex) + ": coordinate '" +
+               token + "' is not finite";
+  }
+  return {};
+}
+
+SurfaceMesh fromScene(const aiScene* scene, const Assimp::Importer& importer, const Source& source) {
+  const std::string& path = source.path;
   if (!scene || !scene->mRootNode) {
     const std::string error = importer.GetErrorString();  // our readers' (own_readers.h) already name the file
     throw MeshError(error.rfind(path + ":", 0) == 0 ? error : path + ": cannot read: " + error);
@@ -86,8 +128,10 @@ SurfaceMesh fromScene(const aiScene* scene, const Assimp::Importer& importer, co
     for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
       const aiVector3D& p = mesh->mVertices[v];
       const std::array<double, 3> x{p.x, p.y, p.z};
-      if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2]))
+      if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2])) {
+        if (const std::string where = source.obj ? nonFiniteObjVertex(source) : ""; !where.empty()) throw MeshError(where);
         throw MeshError(path + ": mesh " + std::to_string(m) + ", vertex " + std::to_string(v) + ": coordinate is not finite");
+      }
       const auto [it, added] = welded.emplace(x, static_cast<int>(s.positions.size() / 3));
       if (added) s.positions.insert(s.positions.end(), x.begin(), x.end());
       index[v] = it->second;
@@ -105,8 +149,7 @@ SurfaceMesh fromScene(const aiScene* scene, const Assimp::Importer& importer, co
 } // namespace
 
 bool isTetMeshPath(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = lowerExtension(path);
   return ext == ".vtu" || ext == ".vtk" || ext == ".msh" || ext == ".mesh" || ext == ".veg" || ext == ".node" ||
          ext == ".ele";
 }
@@ -118,14 +161,14 @@ SurfaceMesh readSurfaceFile(const std::string& path) {
   if (isTetMeshPath(path)) return tetBoundary(path);
   Assimp::Importer importer;
   configure(importer, path);
-  return fromScene(postProcess(importer, importer.ReadFile(path, kImport), path), importer, path);
+  return fromScene(postProcess(importer, importer.ReadFile(path, kImport), path), importer, {path, lowerExtension(path) == ".obj"});
 }
 
 SurfaceMesh readSurfaceMemory(const void* data, size_t size, const std::string& extension, const std::string& name) {
   Assimp::Importer importer;
   configure(importer, name);
   return fromScene(postProcess(importer, importer.ReadFileFromMemory(data, size, kImport, extension.c_str()), name), importer,
-                   name);
+                   {name, lower(extension) == "obj", data, size});
 }
 
 } // namespace quiver

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include "common/mesh_error.h"
 #include "common/surface_check.h"
@@ -59,6 +60,18 @@ TEST(ReadSurface, WhatIsNotASurfaceIsNamed) {
   const std::string model = test::asset("../fuzz/seeds/qvr/float64.qvr");
   EXPECT_NE(test::errorOf<MeshError>([&] { readSurfaceFile(model); }).find("a baked model (.qvr), not a mesh"),
             std::string::npos);
+}
+
+TEST(ReadSurface, ANonFiniteObjCoordinateIsNamedAtItsLine) {
+  // Assimp numbers the vertices of its faces' corners, so its index named no line of the file.
+  const std::string text = "# a tetrahedron\nv 0 0 0\nv 1 0 0\n\nv 0 nan 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n";
+  EXPECT_EQ(test::errorOf<MeshError>([&] { readSurfaceMemory(text.data(), text.size(), "obj", "bad.obj"); }),
+            "bad.obj:5: vertex 3: coordinate 'nan' is not finite");
+  const std::string path = test::tempDir("ReadSurfaceNonFiniteObj") + "/bad.OBJ";
+  std::string overflowing = text;
+  overflowing.replace(overflowing.find("nan"), 3, "1e999");
+  std::ofstream(path, std::ios::binary) << overflowing;
+  EXPECT_EQ(test::errorOf<MeshError>([&] { readSurfaceFile(path); }), path + ":5: vertex 3: coordinate '1e999' is not finite");
 }
 
 TEST(ReadSurface, PolygonsTooLargeToTriangulateAreRefusedInEveryFormat) {
