@@ -1,6 +1,7 @@
 // quiver-bake: turns a tetrahedral mesh into a reduced model. Runs on one or many MPI ranks
 // (mpirun -n N quiver-bake ...); PETSc/SLEPc options (-factor_*, -eps_*, -st_*, -log_view)
 // pass through to the solvers.
+#include <csignal>
 #include <cstdlib>
 #include <iostream>
 
@@ -8,6 +9,7 @@
 #include "formats/mesh/read_surface.h"
 #include "precompute/bake.h"
 #include "precompute/blas_core.h"
+#include "precompute/child_process.h"
 
 using namespace quiver;
 
@@ -126,6 +128,12 @@ int main(int argc, char** argv) {
     checkBakeSettings(s);  // before any work
     s.mesh.fixed = fixedOptions.resolved();
     runBake(ctx, s);
+  } catch (const Interrupted& e) {
+    // gmsh is stopped and the stack unwound, its temporary folder with it: end as signalled (the
+    // other ranks had the signal too: no agreeing on an error).
+    std::cerr << "quiver-bake: " << e.what() << std::endl;
+    std::signal(e.signal, SIG_DFL);
+    std::raise(e.signal);
   } catch (const std::exception& e) {
     error = e.what();
   }

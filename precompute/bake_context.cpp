@@ -7,6 +7,8 @@
 #include <cblas.h>
 #include <slepcsys.h>
 
+#include "precompute/child_process.h"
+
 namespace quiver {
 
 namespace {
@@ -64,6 +66,8 @@ void BakeContext::onRankZero(const std::function<void()>& work) const {
   if (rank_ == 0) {
     try {
       work();
+    } catch (const Interrupted&) {
+      throw;  // a signal every rank had: nothing to agree on (child_process.h)
     } catch (const std::exception& e) {
       error = e.what();
       if (error.empty()) error = "unknown error";

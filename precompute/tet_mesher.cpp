@@ -14,6 +14,7 @@
 #include "common/mesh_error.h"
 #include "common/mesh_quality.h"
 #include "formats/mesh/read_mesh.h"
+#include "precompute/child_process.h"
 
 namespace quiver {
 
@@ -122,11 +123,11 @@ MesherResult tetrahedralize(const CheckedSurface& surface, const MesherSettings&
     const int attempts = s.edgeLength > 0 || result.runs ? 1 : 2;
     for (int attempt = 0; attempt < attempts; ++attempt) {
       std::ofstream(folder.path / "surface.geo") << script(h * pass.scale, pass.threshold);
-      const std::string command = "cd '" + folder.path.string() + "' && '" + s.program +
+      const std::string command = "cd '" + folder.path.string() + "' && exec '" + s.program +
                                   "' surface.geo -3 -nt 1 -format msh22 -o tets.msh > gmsh.log 2>&1";
       ++result.runs;
       // A failed run may still write an empty .msh.
-      if (std::system(command.c_str()) != 0 || !fs::exists(folder.path / "tets.msh") || fs::file_size(folder.path / "tets.msh") < 200)
+      if (runChild(command) != 0 || !fs::exists(folder.path / "tets.msh") || fs::file_size(folder.path / "tets.msh") < 200)
         fail("gmsh could not make tets of the surface:" + lastLines(folder.path / "gmsh.log", 3));
       CheckedMesh checked = loadMesh((folder.path / "tets.msh").string());
       result.mesh = std::move(checked.mesh);
