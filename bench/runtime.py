@@ -39,6 +39,22 @@ def vega_steps(shared, tmp, repetitions):
     return steps
 
 
+def bake_beams(apps, tmp, ranks):
+    """The 1 x 0.1 x 0.1 cantilever (40 x 4 x 4 cells) baked at each r on 2 ranks: the .qvr paths."""
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_pml="ob1")
+    mesh = os.path.join(tmp, "beam.vtu")
+    subprocess.run([os.path.join(apps, "quiver-mesh"), "beam", "--size", "1,0.1,0.1", "--cells", "40,4,4", "-o", mesh],
+                   check=True)
+    models = []
+    for r in ranks:
+        name = os.path.join(tmp, f"r{r}")
+        subprocess.run(["mpirun", "-n", "2", os.path.join(apps, "quiver-bake"), mesh, "--fix", "x<min+1e-9",
+                        "--modes", "12", "--rank", str(r), "--quiet", "-o", name], check=True, env=env,
+                       stdin=subprocess.DEVNULL)
+        models.append(name + ".qvr")
+    return models
+
+
 def heading(*columns, text=("solver",)):
     """A markdown table's header row and its alignment row (numbers right, `text` columns left)."""
     print("| " + " | ".join(columns) + " |")
@@ -51,19 +67,8 @@ def main():
     ap.add_argument("--repetitions", type=int, default=3)
     ap.add_argument("--shared", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared"))
     args = ap.parse_args()
-    apps = os.path.join(args.build, "apps")
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_pml="ob1")
     with tempfile.TemporaryDirectory() as tmp:
-        mesh = os.path.join(tmp, "beam.vtu")
-        subprocess.run([os.path.join(apps, "quiver-mesh"), "beam", "--size", "1,0.1,0.1", "--cells", "40,4,4", "-o", mesh],
-                       check=True)
-        models = []
-        for r in RANKS:
-            name = os.path.join(tmp, f"r{r}")
-            subprocess.run(["mpirun", "-n", "2", os.path.join(apps, "quiver-bake"), mesh, "--fix", "x<min+1e-9",
-                            "--modes", "12", "--rank", str(r), "--quiet", "-o", name], check=True, env=env,
-                           stdin=subprocess.DEVNULL)
-            models.append(name + ".qvr")
+        models = bake_beams(os.path.join(args.build, "apps"), tmp, RANKS)
         out = subprocess.run([os.path.join(args.build, "bench", "bench_runtime"), *models, "--benchmark_format=json",
                               f"--benchmark_repetitions={args.repetitions}", "--benchmark_report_aggregates_only=true"],
                              check=True, capture_output=True, text=True).stdout

@@ -1,0 +1,75 @@
+#!/usr/bin/python3
+"""Two versions of the runtime alternated on this CPU, for changes smaller than a shared machine's
+noise (on this project's VMs the same crowd read 16 to 23 ms within minutes while the FMA peak held:
+neighbours fill the shared caches). Builds bench_runtime at --base (a commit, in a temporary
+worktree: the runtime and the bench alone, about 15 s) unless --base names a bench_runtime binary,
+bakes the cantilever at r as bench/runtime.py does, and runs the two binaries in turn, --runs times
+each, every run with this core's FMA peak measured in it. Prints the CPU and BLAS core, then each
+benchmark's median and fastest run for both and the median's ratio.
+
+    /usr/bin/python3 bench/ab.py --base 811b657 [--build build/release] [--r 30] [--runs 8] [--seconds 1]
+        [--filter 'ManyObjects/.*/together|EvaluateGroup/r']
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import tempfile
+
+from machine import machine_line
+from runtime import bake_beams
+
+
+def build_base(commit, tmp):
+    """bench_runtime built at `commit` in a worktree under tmp (removed by the caller's cleanup)."""
+    source = os.path.join(tmp, "base")
+    subprocess.run(["git", "worktree", "add", "--detach", "-q", source, commit], check=True)
+    try:
+        subprocess.run(["cmake", "-S", source, "-B", os.path.join(source, "build"), "-G", "Ninja", "-DCMAKE_BUILD_TYPE=Release",
+                        *[f"-DQUIVER_BUILD_{part}=OFF" for part in ("BAKE", "TESTS", "PYTHON", "VIEWER", "EXAMPLES", "TOOLS")],
+                        "-DQUIVER_BUILD_BENCH=ON"], check=True, capture_output=True)
+        subprocess.run(["ninja", "-C", os.path.join(source, "build"), "bench_runtime"], check=True, capture_output=True)
+        binary = os.path.join(tmp, "bench_runtime_base")
+        os.replace(os.path.join(source, "build", "bench", "bench_runtime"), binary)
+        return binary
+    finally:
+        subprocess.run(["git", "worktree", "remove", "--force", source], check=True)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--base", required=True, help="a commit, or a bench_runtime binary")
+    ap.add_argument("--build", default="build/release", help="the build of the new version (its bench_runtime, its bake)")
+    ap.add_argument("--r", type=int, default=30)
+    ap.add_argument("--runs", type=int, default=8)
+    ap.add_argument("--seconds", type=float, default=1.0, help="each benchmark's time in each run")
+    ap.add_argument("--filter", default="ManyObjects/.*/together|EvaluateGroup/r")
+    args = ap.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        base = args.base if os.path.isfile(args.base) else build_base(args.base, tmp)
+        binaries = {"base": base, "new": os.path.join(args.build, "bench", "bench_runtime")}
+        model = bake_beams(os.path.join(args.build, "apps"), tmp, [args.r])[0]
+        times, peaks = {}, {"base": [], "new": []}
+        for _ in range(args.runs):
+            for side, binary in binaries.items():
+                out = subprocess.run([binary, model, f"--benchmark_filter=PeakFma|{args.filter}", "--benchmark_format=json",
+                                      f"--benchmark_min_time={args.seconds}"], check=True, capture_output=True, text=True).stdout
+                for b in json.loads(out)["benchmarks"]:
+                    if b["name"] == "PeakFma":
+                        peaks[side].append(b["GFLOPS"] / 1e9)
+                    else:
+                        times.setdefault(f"{b['name']} ({b['time_unit']})", {"base": [], "new": []})[side].append(b["real_time"])
+    print(machine_line())
+    print(f"FMA peak in the runs: base {min(peaks['base']):.1f}-{max(peaks['base']):.1f}, "
+          f"new {min(peaks['new']):.1f}-{max(peaks['new']):.1f} GFLOP/s; {args.runs} runs each, alternated\n")
+    print("| benchmark | base median | base fastest | new median | new fastest | new / base (medians) |")
+    print("|---|---:|---:|---:|---:|---:|")
+    for name, sides in times.items():
+        b, n = sides["base"], sides["new"]
+        print(f"| {name} | {statistics.median(b):.4g} | {min(b):.4g} | {statistics.median(n):.4g} | {min(n):.4g} | "
+              f"{statistics.median(n) / statistics.median(b):.3f} |")
+
+
+if __name__ == "__main__":
+    main()
