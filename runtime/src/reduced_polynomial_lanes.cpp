@@ -103,10 +103,12 @@ template <size_t G, int W>
     for (int n = 0; n < N; ++n) V::at(y + (p + g) * L + n * W) = sum[g][n];
 }
 
+// Eight running vectors, as the first pass keeps: four pairs of two AVX2 vectors, or eight pairs of
+// one AVX-512 vector (four alone would wait on the multiply-add latency).
 template <int W>
 QV_HOT void gatheredProductLanes(const double* U, const uint32_t* tripleOf, int r, size_t pairs, const double* q,
                                  double* y) {
-  constexpr size_t G = 4;
+  constexpr size_t G = 8 / Doubles<W>::kPerItem;
   size_t p = 0;
   for (; p + G <= pairs; p += G) gatheredPairsLanes<G, W>(U, tripleOf, r, p, q, y);
   for (; p < pairs; ++p) gatheredPairsLanes<1, W>(U, tripleOf, r, p, q, y);
