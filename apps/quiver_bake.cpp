@@ -129,11 +129,12 @@ int main(int argc, char** argv) {
     s.mesh.fixed = fixedOptions.resolved();
     runBake(ctx, s);
   } catch (const Interrupted& e) {
-    // gmsh is stopped and the stack unwound, its temporary folder with it: end as signalled (the
-    // other ranks had the signal too: no agreeing on an error).
+    // gmsh is stopped and the stack unwound, its temporary folder with it: end as signalled, with
+    // no agreeing on an error (the other ranks had the signal too, or mpirun stops them).
     std::cerr << "quiver-bake: " << e.what() << std::endl;
     std::signal(e.signal, SIG_DFL);
     std::raise(e.signal);
+    return 128 + e.signal;  // were it blocked in this thread
   } catch (const std::exception& e) {
     error = e.what();
   }

@@ -67,7 +67,7 @@ void BakeContext::onRankZero(const std::function<void()>& work) const {
     try {
       work();
     } catch (const Interrupted&) {
-      throw;  // a signal every rank had: nothing to agree on (child_process.h)
+      throw;  // the bake ends as signalled, agreeing on nothing (child_process.h, quiver-bake's main)
     } catch (const std::exception& e) {
       error = e.what();
       if (error.empty()) error = "unknown error";

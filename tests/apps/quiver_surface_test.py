@@ -286,23 +286,33 @@ class Surface(unittest.TestCase):
                     found.append(int(stat.split("/")[2]))
             return found
 
-        for sig in (signal.SIGTERM, signal.SIGINT):
+        # SIGTERM as kill or a job scheduler sends it: to the bake alone. SIGINT as a terminal's Ctrl-C
+        # sends it: to the bake's whole process group, gmsh included, which may end of it first.
+        for sig, whole_group in ((signal.SIGTERM, False), (signal.SIGINT, True)):
             with tempfile.TemporaryDirectory() as tmp:
-                # SIGINT as a terminal delivers it: not ignored, whatever this test's parents ignore.
                 p = subprocess.Popen([BAKE, self.obj, "--tets", "400000", "--modes", "8", "--rank", "16", "--no-fidelity",
                                       "-o", os.path.join(tmp, "stopped")], env=dict(os.environ, TMPDIR=tmp),
                                      stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                                     preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-                deadline, started = time.monotonic() + 120, []
-                while not started and p.poll() is None and time.monotonic() < deadline:
-                    time.sleep(0.05)
-                    started = glob.glob(os.path.join(tmp, "quiver-mesher-*", "surface.geo"))
-                self.assertTrue(started, "gmsh never started")
-                time.sleep(0.5)
-                gmsh = gmsh_children(p.pid)
-                self.assertTrue(gmsh, "gmsh is not the bake's child")
-                p.send_signal(sig)
-                _, err = p.communicate(timeout=60)
+                                     start_new_session=True,  # a group of its own, as a terminal's job
+                                     preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # whatever we ignore
+                try:
+                    deadline, started = time.monotonic() + 120, []
+                    while not started and p.poll() is None and time.monotonic() < deadline:
+                        time.sleep(0.05)
+                        started = glob.glob(os.path.join(tmp, "quiver-mesher-*", "surface.geo"))
+                    self.assertTrue(started, "gmsh never started")
+                    time.sleep(0.5)
+                    gmsh = gmsh_children(p.pid)
+                    self.assertTrue(gmsh, "gmsh is not the bake's child")
+                    if whole_group:
+                        os.killpg(p.pid, sig)
+                    else:
+                        p.send_signal(sig)
+                    _, err = p.communicate(timeout=60)
+                finally:
+                    if p.poll() is None:
+                        os.killpg(p.pid, signal.SIGKILL)
+                        p.wait()
                 self.assertEqual(p.returncode, -sig, err)
                 self.assertIn("quiver-bake: interrupted by", err)
                 self.assertEqual(glob.glob(os.path.join(tmp, "quiver-mesher-*")), [])
