@@ -18,7 +18,8 @@ void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales&
                                  scales.dampingStiffness * D[i * r + j] + (i == j ? scales.identity : 0.0);
 }
 
-void dampWithStiffness(const qv_instance& s, const double* K, double* D, bool definite) {
+// QV_HOT: its factorisation built as choleskyFactorLanes() is, so that a group's verdict is its own.
+QV_HOT void dampWithStiffness(const qv_instance& s, const double* K, double* D, bool definite) {
   const int r = s.r;
   if (definite) {  // the ladder's first rung, which would succeed
     if (D != K) std::memcpy(D, K, sizeof(double) * r * r);

@@ -53,6 +53,7 @@ struct StepBuffers {
   // Whether the group found that K(q) positive definite, as choleskyFactor() judges (a minimising
   // step's damping at its end takes it as it is: dampWithStiffness()).
   bool presetDefinite = false;
+  unsigned long long presetDefinitesTaken = 0;  // ends damped by that verdict (tests, diagnostics)
   // The group also factorises the matrix the step will solve with at that point (the system with
   // presetScales), in its own scratch; the solver takes it right after the preset
   // (takePresetFactor(), dynamics.h) instead of filling and factorising its own. Untaken (the

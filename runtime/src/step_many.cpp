@@ -117,7 +117,8 @@ QV_HOT double* evaluateTogether(qv_instance* const* members, int count, double* 
 // their Cholesky factorisations together in `scratch` (the pairs times kLanes doubles): a
 // minimising step that ends at its point damps the next with K itself then (dampWithStiffness()),
 // which alone factorised K once more, a ninth of a crowd's frame at r = 30. The factorisation's
-// operations are choleskyFactor()'s, so the verdict is that of the one it saves.
+// operations are choleskyFactor()'s, built for the same instruction set (both QV_HOT), so the
+// verdict is that of the one it saves.
 void markDefinite(qv_instance* const* members, int count, const double* K, double* scratch) {
   const int r = members[0]->r;
   std::memcpy(scratch, K, sizeof(double) * pairs(r) * kLanes);

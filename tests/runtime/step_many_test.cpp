@@ -329,9 +329,12 @@ TEST(StepMany, MinimisingStepsDampTheNextAsTheirOwnLadderWould) {
       (quiver::rt::choleskyFactor(factor.data(), r) ? definite : indefinite)++;
     }
   }
-  std::printf("%d ends with K positive definite, %d not\n", definite, indefinite);
+  unsigned long long taken = 0;
+  for (qv_instance* s : crowd.instances) taken += s->work.presetDefinitesTaken;
+  std::printf("%d ends with K positive definite, %d not; %llu damped by the group's verdict\n", definite, indefinite, taken);
   EXPECT_GT(definite, 0);
   EXPECT_GT(indefinite, 0);
+  EXPECT_GT(taken, 0u);  // the group's verdict was used, not only the ladder
 }
 
 // Free bars thrown spinning onto a plane, each its own way, twice: `batched` stepped together,

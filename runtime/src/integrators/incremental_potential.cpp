@@ -262,7 +262,9 @@ void MinimizeTask::finish() {
   // The next step damps with K at this end: the last evaluation's (at_'s), unless the budget moved x.
   if (s.lastStep.held_back)
     evaluateElasticity(*s.model, s.config.elasticity, s.end.q, nullptr, s.work.force, s.work.stiffness, s.work.polynomialScratch);
-  dampWithStiffness(s, s.work.stiffness, s.dampingStiffness, at_.definite && !s.lastStep.held_back);
+  const bool definite = at_.definite && !s.lastStep.held_back;
+  s.work.presetDefinitesTaken += definite;
+  dampWithStiffness(s, s.work.stiffness, s.dampingStiffness, definite);
   phase_ = Phase::Done;
 }
 

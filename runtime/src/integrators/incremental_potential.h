@@ -67,7 +67,9 @@ struct PhiPoint {
 // pending() is null, then status(). Plain data: a group keeps a few and moves them between lanes.
 // A Newton direction in the group's factor is a part of its own, between two resume() calls: its
 // right-hand side is in s.work.correction and awaitedSolve() names the factor; the group may solve
-// it there and call solved(), else the next resume() solves it.
+// it there and call solved(), else the next resume() solves it. Either way before the group
+// evaluates again (pending() still names the point already evaluated; the factor lives in the
+// group's scratch).
 class MinimizeTask {
 public:
   // From the guess in s.end.q, with qt in s.work.predictor and v0 in s.work.predictorVelocity.
