@@ -20,21 +20,30 @@ import tempfile
 from machine import machine_line
 from runtime import bake_beams
 
+REPOSITORY = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def quietly(command):
+    """Runs `command`; on failure, stops with its output."""
+    p = subprocess.run(command, capture_output=True, text=True)
+    if p.returncode != 0:
+        raise SystemExit(f"{' '.join(command)} failed:\n{p.stdout}{p.stderr}")
+
 
 def build_base(commit, tmp):
-    """bench_runtime built at `commit` in a worktree under tmp (removed by the caller's cleanup)."""
+    """bench_runtime built at `commit` in a worktree under tmp, the worktree removed again."""
     source = os.path.join(tmp, "base")
-    subprocess.run(["git", "worktree", "add", "--detach", "-q", source, commit], check=True)
+    quietly(["git", "-C", REPOSITORY, "worktree", "add", "--detach", "-q", source, commit])
     try:
-        subprocess.run(["cmake", "-S", source, "-B", os.path.join(source, "build"), "-G", "Ninja", "-DCMAKE_BUILD_TYPE=Release",
-                        *[f"-DQUIVER_BUILD_{part}=OFF" for part in ("BAKE", "TESTS", "PYTHON", "VIEWER", "EXAMPLES", "TOOLS")],
-                        "-DQUIVER_BUILD_BENCH=ON"], check=True, capture_output=True)
-        subprocess.run(["ninja", "-C", os.path.join(source, "build"), "bench_runtime"], check=True, capture_output=True)
+        quietly(["cmake", "-S", source, "-B", os.path.join(source, "build"), "-G", "Ninja", "-DCMAKE_BUILD_TYPE=Release",
+                 *[f"-DQUIVER_BUILD_{part}=OFF" for part in ("BAKE", "TESTS", "PYTHON", "VIEWER", "EXAMPLES", "TOOLS")],
+                 "-DQUIVER_BUILD_BENCH=ON"])
+        quietly(["ninja", "-C", os.path.join(source, "build"), "bench_runtime"])
         binary = os.path.join(tmp, "bench_runtime_base")
         os.replace(os.path.join(source, "build", "bench", "bench_runtime"), binary)
         return binary
     finally:
-        subprocess.run(["git", "worktree", "remove", "--force", source], check=True)
+        subprocess.run(["git", "-C", REPOSITORY, "worktree", "remove", "--force", source])
 
 
 def main():
@@ -51,8 +60,9 @@ def main():
         binaries = {"base": base, "new": os.path.join(args.build, "bench", "bench_runtime")}
         model = bake_beams(os.path.join(args.build, "apps"), tmp, [args.r])[0]
         times, peaks = {}, {"base": [], "new": []}
-        for _ in range(args.runs):
-            for side, binary in binaries.items():
+        for run in range(args.runs):
+            for side in ("base", "new") if run % 2 == 0 else ("new", "base"):
+                binary = binaries[side]
                 out = subprocess.run([binary, model, f"--benchmark_filter=PeakFma|{args.filter}", "--benchmark_format=json",
                                       f"--benchmark_min_time={args.seconds}"], check=True, capture_output=True, text=True).stdout
                 for b in json.loads(out)["benchmarks"]:
@@ -61,8 +71,11 @@ def main():
                     else:
                         times.setdefault(f"{b['name']} ({b['time_unit']})", {"base": [], "new": []})[side].append(b["real_time"])
     print(machine_line())
-    print(f"FMA peak in the runs: base {min(peaks['base']):.1f}-{max(peaks['base']):.1f}, "
-          f"new {min(peaks['new']):.1f}-{max(peaks['new']):.1f} GFLOP/s; {args.runs} runs each, alternated\n")
+    if peaks["base"] and peaks["new"]:
+        print(f"FMA peak in the runs: base {min(peaks['base']):.1f}-{max(peaks['base']):.1f}, "
+              f"new {min(peaks['new']):.1f}-{max(peaks['new']):.1f} GFLOP/s; {args.runs} runs each, alternated\n")
+    else:
+        print(f"(no FMA peak: this CPU has neither AVX2 nor AVX-512); {args.runs} runs each, alternated\n")
     print("| benchmark | base median | base fastest | new median | new fastest | new / base (medians) |")
     print("|---|---:|---:|---:|---:|---:|")
     for name, sides in times.items():

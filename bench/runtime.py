@@ -39,14 +39,14 @@ def vega_steps(shared, tmp, repetitions):
     return steps
 
 
-def bake_beams(apps, tmp, ranks):
-    """The 1 x 0.1 x 0.1 cantilever (40 x 4 x 4 cells) baked at each r on 2 ranks: the .qvr paths."""
+def bake_beams(apps, tmp, basis_sizes):
+    """The 1 x 0.1 x 0.1 cantilever (40 x 4 x 4 cells) baked at each r of basis_sizes on 2 ranks: the .qvr paths."""
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_pml="ob1")
     mesh = os.path.join(tmp, "beam.vtu")
     subprocess.run([os.path.join(apps, "quiver-mesh"), "beam", "--size", "1,0.1,0.1", "--cells", "40,4,4", "-o", mesh],
                    check=True)
     models = []
-    for r in ranks:
+    for r in basis_sizes:
         name = os.path.join(tmp, f"r{r}")
         subprocess.run(["mpirun", "-n", "2", os.path.join(apps, "quiver-bake"), mesh, "--fix", "x<min+1e-9",
                         "--modes", "12", "--rank", str(r), "--quiet", "-o", name], check=True, env=env,
