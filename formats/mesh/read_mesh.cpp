@@ -30,13 +30,11 @@ std::string readFileBytes(const std::string& path) {
   return buf.str();
 }
 
-namespace {
 std::string lowerExtension(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   return ext;
 }
-} // namespace
 
 MeshFormat detectMeshFormat(const std::string& path, std::string_view head) {
   const std::string ext = lowerExtension(path);

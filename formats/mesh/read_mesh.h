@@ -35,6 +35,9 @@ std::ifstream openForReading(const std::string& path);
 // The whole file, or the same MeshError.
 std::string readFileBytes(const std::string& path);
 
+// The extension of `path` in lower case, with its dot (".vtu"), or "" when it has none.
+std::string lowerExtension(const std::string& path);
+
 // From the extension (.node/.ele/.msh/.mesh/.veg/.vtk/.vtu) and, for .mesh, the first line.
 MeshFormat detectMeshFormat(const std::string& path, std::string_view head);
 const char* meshFormatName(MeshFormat f);

@@ -8,6 +8,8 @@
 #include <map>
 #include <sstream>
 
+#include <strings.h>
+
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -57,12 +59,6 @@ const aiScene* postProcess(Assimp::Importer& importer, const aiScene* imported, 
   }
   return importer.ApplyPostProcessing(kSteps);
 }
-
-std::string lower(std::string text) {
-  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return text;
-}
-std::string lowerExtension(const std::string& path) { return lower(std::filesystem::path(path).extension().string()); }
 
 // The file behind a scene: its name, and where an OBJ's text can be read again (bytes in memory,
 // or null: the file at `path`).
@@ -168,7 +164,7 @@ SurfaceMesh readSurfaceMemory(const void* data, size_t size, const std::string& 
   Assimp::Importer importer;
   configure(importer, name);
   return fromScene(postProcess(importer, importer.ReadFileFromMemory(data, size, kImport, extension.c_str()), name), importer,
-                   {name, lower(extension) == "obj", data, size});
+                   {name, strcasecmp(extension.c_str(), "obj") == 0, data, size});
 }
 
 } // namespace quiver
