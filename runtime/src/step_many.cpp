@@ -17,6 +17,10 @@ constexpr int kLanes = ReducedPolynomial::kLanes;
 
 size_t pairs(int r) { return static_cast<size_t>(r) * (r + 1) / 2; }
 
+// A job's scratch (stepManyScratchPerJob()) holds the group's K packed by lane, then what the
+// evaluation uses, which is free again once it has run: where that second part begins.
+double* afterStiffness(double* scratch, int r) { return scratch + pairs(r) * kLanes; }
+
 // Whose step begins with a polynomial evaluation (implicit Newmark's: the minimiser's at
 // newmarkGuess(), the fixed Newton step's at q), on a model laid out for groups
 // (qv_model_config.group_layout).
@@ -103,7 +107,7 @@ QV_HOT double* evaluateTogether(qv_instance* const* members, int count, double* 
     force[l] = members[l]->work.presetForce;
     stiffness[l] = members[l]->work.stiffness;
   }
-  members[0]->model->polynomial.evaluateLanes(at, count, energy, force, stiffnessLanes, scratch + pairs(r) * kLanes);
+  members[0]->model->polynomial.evaluateLanes(at, count, energy, force, stiffnessLanes, afterStiffness(scratch, r));
   unpackSymmetric(stiffnessLanes, r, count, stiffness);
   for (int l = 0; l < count; ++l) {
     members[l]->work.presetEnergy = energy[l];
@@ -185,7 +189,7 @@ void stepNewtonGroup(qv_instance* const* group, const int* index, int count, dou
     factor[l] = going[l] ? takePresetFactor(s, newtonSystem(s, c1, c2)) : LaneFactor{};
   }
   // The evaluation's scratch is free again: the right-hand sides go there.
-  solveTogether(group, factor, count, scratch + pairs(group[0]->r) * kLanes);
+  solveTogether(group, factor, count, afterStiffness(scratch, group[0]->r));
   for (int l = 0; l < count; ++l) {
     qv_instance& s = *group[l];
     if (going[l]) status[l] = endNewmarkNewton(s, step[l], factor[l].A != nullptr);
@@ -224,13 +228,13 @@ void stepMinimizingTogether(qv_instance* const* instances, Next next, double* sc
     for (int l = 0; l < active; ++l) scales[l] = minimizerSystem(*member[l], predictor[l]);
     double* K = evaluateTogether(member, active, scratch);
     // The evaluation's scratch is free again.
-    markDefinite(member, active, K, scratch + pairs(member[0]->r) * kLanes);
+    markDefinite(member, active, K, afterStiffness(scratch, member[0]->r));
     factoriseGroup(member, active, scales, K);
     for (int l = 0; l < active; ++l) task[l].resume();
     // The Newton directions the steps take from there, solved together.
     LaneFactor factor[kLanes];
     for (int l = 0; l < active; ++l) factor[l] = task[l].awaitedSolve();
-    solveTogether(member, factor, active, scratch + pairs(member[0]->r) * kLanes);
+    solveTogether(member, factor, active, afterStiffness(scratch, member[0]->r));
     for (int l = 0; l < active; ++l)
       if (factor[l].A) task[l].solved(), task[l].resume();
     for (int l = 0; l < active;) {
