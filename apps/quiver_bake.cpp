@@ -92,6 +92,10 @@ int main(int argc, char** argv) {
                "Skip the fidelity report (the reduced model against full-space StVK on static loads: serial, the "
                "slowest stage on large meshes)");
   app.add_flag("--export-npy", s.output.exportNpy, "Also write NAME.eigenvalues.npy, NAME.modes.npy and NAME.U.npy (float64)");
+  app.add_option("--threads", s.threads,
+                 "Threads per rank of the polynomial stage (default: the cores the rank may run on, shared among "
+                 "the ranks of its machine; mpirun binds each rank to one core). The results do not depend on it")
+      ->check(app::Positive);
   app.add_flag("--resume", s.resume, "Reuse the stages of NAME.h5.partial (or NAME.h5) whose inputs have not changed");
   app.add_option("-o,--output", s.output.name, "Output name: writes NAME.qvr, NAME.h5 and NAME.xmf")
       ->required()

@@ -2,9 +2,11 @@
 // energy as a quartic in q, one blocked dsyrk over the tets. Run under mpirun; prints one CSV line
 // per r (rank 0):
 //
-//   mesh,tets,r,ranks,seconds,us_per_tet,tets_r4_per_s,gflops,dgemm_peak_gflops_per_rank,fraction_of_peak
+//   mesh,tets,r,ranks,threads,seconds,us_per_tet,tets_r4_per_s,gflops,dgemm_peak_gflops_per_rank,fraction_of_peak
 //
-//   mpirun -n 2 bench_polynomials MESH [--r 10,20,30,40] [--repeat 3] [--min-time 0.5] [--no-header]
+//   mpirun -n 2 bench_polynomials MESH [--r 10,20,30,40] [--threads 1] [--repeat 3] [--min-time 0.5] [--no-header]
+//
+// --threads: the stage's threads per rank (PolynomialSettings::threads; quiver-bake's --threads).
 //
 // The stage's cost does not depend on the constraints or on the basis values, so the basis is a
 // random 3n x r matrix with a fixed seed (the same on every rank). Each r is timed between MPI
@@ -17,7 +19,8 @@
 //
 // Peak: single-thread cblas_dgemm on 1536 x 1536 matrices, on every rank at the same time (as the
 // stage runs), best of 5 before the first r and after each r; each r reports the best so far,
-// averaged over ranks. A comment line per r gives the time of the stage's dsyrk calls alone (same
+// averaged over ranks; the fraction of peak is over ranks times threads such peaks (one per core
+// at work: the DGEMM peak of one core). A comment line per r gives the time of the stage's dsyrk calls alone (same
 // shapes, rows filled once): how much of the stage is BLAS and how much the row building, and the
 // time of the call with no tets on any rank (what every call costs, whatever the mesh).
 //
@@ -53,11 +56,13 @@ struct Options {
   int repeat = 3;
   double minTime = 0.5;
   int peakSize = 1536;
+  int threads = 1;
   bool header = true;
 };
 
 const char* const kUsage =
-    "usage: bench_polynomials MESH [--r 10,20,30,40] [--repeat 3] [--min-time 0.5] [--peak-size 1536] [--no-header]\n";
+    "usage: bench_polynomials MESH [--r 10,20,30,40] [--threads 1] [--repeat 3] [--min-time 0.5] [--peak-size 1536] "
+    "[--no-header]\n";
 
 std::vector<int> parseList(const std::string& text) {
   std::vector<int> out;
@@ -84,6 +89,7 @@ Options parseOptions(int argc, char** argv) {
     else if (a == "--repeat") o.repeat = std::max(1, std::stoi(value()));
     else if (a == "--min-time") o.minTime = std::stod(value());
     else if (a == "--peak-size") o.peakSize = std::max(64, std::stoi(value()));
+    else if (a == "--threads") o.threads = std::max(1, std::stoi(value()));
     else if (a == "--no-header") o.header = false;
     else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option " + a);
     else if (o.mesh.empty()) o.mesh = a;
@@ -184,11 +190,12 @@ int run(const quiver::BakeContext& ctx, const Options& o) {
     for (Eigen::Index i = 0; i < U.rows(); ++i) U(i, j) = uniform(rng);
 
   if (ctx.rank() == 0) {
-    std::printf("# OpenBLAS %s, core %s, %d thread(s) per rank; %d rank(s), at most %lld of %lld tets on one rank\n",
-                openblas_get_config(), openblas_get_corename(), openblas_get_num_threads(), ranks,
+    std::printf("# OpenBLAS %s, core %s, %d thread(s) per call; %d rank(s) of %d stage thread(s), at most %lld of "
+                "%lld tets on one rank\n",
+                openblas_get_config(), openblas_get_corename(), openblas_get_num_threads(), ranks, o.threads,
                 static_cast<long long>(mostTets), static_cast<long long>(tets));
     if (o.header)
-      std::printf("mesh,tets,r,ranks,seconds,us_per_tet,tets_r4_per_s,gflops,dgemm_peak_gflops_per_rank,"
+      std::printf("mesh,tets,r,ranks,threads,seconds,us_per_tet,tets_r4_per_s,gflops,dgemm_peak_gflops_per_rank,"
                   "fraction_of_peak\n");
     std::fflush(stdout);
   }
@@ -198,7 +205,8 @@ int run(const quiver::BakeContext& ctx, const Options& o) {
   double peak = dgemmPeak(comm, o.peakSize, 5);
   for (const int r : o.r) {
     const Eigen::MatrixXd basis = U.leftCols(r);
-    const quiver::PolynomialSettings settings;
+    quiver::PolynomialSettings settings;
+    settings.threads = o.threads;
     size_t coefficients = 0;
     const double best = bestOf(comm, o, [&] {
       coefficients = quiver::computeEnergyPolynomial(comm, mesh, perTet, partition.tetPart, basis, settings)
@@ -221,9 +229,10 @@ int run(const quiver::BakeContext& ctx, const Options& o) {
     const double gflops = flops / best * 1e-9;
     const double r4 = static_cast<double>(r) * r * r * r;
     if (ctx.rank() == 0) {
-      std::printf("%s,%lld,%d,%d,%.6f,%.3f,%.4e,%.2f,%.2f,%.3f\n", baseName(o.mesh).c_str(),
-                  static_cast<long long>(tets), r, ranks, best, 1e6 * best / static_cast<double>(tets),
-                  static_cast<double>(tets) * r4 / best, gflops, peakPerRank, gflops / (ranks * peakPerRank));
+      std::printf("%s,%lld,%d,%d,%d,%.6f,%.3f,%.4e,%.2f,%.2f,%.3f\n", baseName(o.mesh).c_str(),
+                  static_cast<long long>(tets), r, ranks, o.threads, best, 1e6 * best / static_cast<double>(tets),
+                  static_cast<double>(tets) * r4 / best, gflops, peakPerRank,
+                  gflops / (ranks * std::min(o.threads, quiver::gramSlices(N, mine)) * peakPerRank));
       std::printf("# r = %d: %zu coefficients; dsyrk alone %.6f s (%.3f of the stage); no tets %.6f s\n", r,
                   coefficients, blas, blas / best, fixed);
       std::fflush(stdout);

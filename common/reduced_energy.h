@@ -30,7 +30,8 @@ class ReducedEnergyRows {
 public:
   // `basis`: 3n x r, vertex order; `tets`: the tets of `mesh` that write() will be given.
   ReducedEnergyRows(const Eigen::MatrixXd& basis, const TetMesh& mesh, const std::vector<int>& tets);
-  int columns() const { return r_ + r_ * (r_ + 1) / 2; }
+  static int columns(int r) { return r + r * (r + 1) / 2; }
+  int columns() const { return columns(r_); }
 
   // B_e (6 x columns()) row by row: row i at B + i * ld (ld >= columns()).
   void write(const Tet& tet, const Matrix34& gradients, double volume, const Material& material, double* B, int64_t ld);

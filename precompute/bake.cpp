@@ -187,7 +187,8 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
 
   const Eigen::MatrixXd fullU = layout.gatherToAll(basis.vectors);
   const EnergyPolynomial energy =
-      polynomialStage(stages, ctx, in.mesh.mesh, in.perTet, partition.tetPart, fullU, polynomialInputHash(basisHash));
+      polynomialStage(stages, ctx, in.mesh.mesh, in.perTet, partition.tetPart, fullU, polynomialInputHash(basisHash),
+                      s.threads > 0 ? s.threads : ctx.coresPerRank());
   const bool small = in.mesh.mesh.tetCount() <= s.fidelity.maxTets;
   if (s.fidelity.enabled && !small)
     ctx.progress("fidelity: skipped: " + std::to_string(in.mesh.mesh.tetCount()) + " tets is above --fidelity-max-tets " +

@@ -26,6 +26,7 @@ struct BakeSettings {
   ExportRequest output;        // NAME, how NAME.qvr stores the model, the .npy exports (stages/export_model.h)
   FidelitySettings fidelity;   // the reduced model against full space at the end (stages/fidelity.h)
   bool resume = false;         // reuse stages of NAME.h5.partial / NAME.h5 whose inputs hash the same
+  int threads = 0;             // threads per rank of the stages that start their own; 0: coresPerRank()
   std::string commandLine;     // for provenance
   std::string petscOptions;    // the PETSc/SLEPc options given, part of the modes' input hash
 };

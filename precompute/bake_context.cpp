@@ -1,8 +1,11 @@
 #include "precompute/bake_context.h"
 
+#include <algorithm>
 #include <cctype>
 #include <iostream>
 #include <stdexcept>
+
+#include <sched.h>
 
 #include <cblas.h>
 #include <slepcsys.h>
@@ -42,7 +45,16 @@ BakeContext::BakeContext(std::vector<std::string> petscArgs) : argStorage_(std::
   if (SlepcInitialize(&argc, &argv, nullptr, nullptr) != 0) throw std::runtime_error("SLEPc/PETSc initialisation failed");
   MPI_Comm_rank(comm(), &rank_);
   MPI_Comm_size(comm(), &size_);
-  openblas_set_num_threads(1);  // parallelism comes from the ranks; threads on top would oversubscribe
+  // Parallelism comes from the ranks, and from the threads of the stages that start their own
+  // (coresPerRank()); BLAS threads on top would oversubscribe.
+  openblas_set_num_threads(1);
+  MPI_Comm node;
+  MPI_Comm_split_type(comm(), MPI_COMM_TYPE_SHARED, rank_, MPI_INFO_NULL, &node);
+  int ranksOnNode = 1;
+  MPI_Comm_size(node, &ranksOnNode);
+  MPI_Comm_free(&node);
+  cpu_set_t cores;
+  if (sched_getaffinity(0, sizeof cores, &cores) == 0) coresPerRank_ = std::max(1, CPU_COUNT(&cores) / ranksOnNode);
 }
 
 BakeContext::~BakeContext() { SlepcFinalize(); }

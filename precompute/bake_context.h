@@ -20,6 +20,9 @@ public:
   MPI_Comm comm() const { return MPI_COMM_WORLD; }
   int rank() const { return rank_; }
   int size() const { return size_; }
+  // The cores this rank may run on (its CPU affinity) shared evenly among the ranks of its node, at
+  // least one: the threads a stage may run. mpirun binds each rank to a core by default: one.
+  int coresPerRank() const { return coresPerRank_; }
   bool quiet = false;
 
   // Rank 0 prints "quiver-bake: <message>" to stdout unless quiet.
@@ -39,7 +42,7 @@ public:
 private:
   std::vector<std::string> argStorage_;
   std::vector<char*> argv_;
-  int rank_ = 0, size_ = 1;
+  int rank_ = 0, size_ = 1, coresPerRank_ = 1;
 };
 
 // The same on any communicator: the lowest failing rank's error, tagged with its rank, on every rank.

@@ -122,6 +122,35 @@ class QuiverBake(unittest.TestCase):
                     self.assertEqual(digest(name), digest(names[0]), "the .qvr bytes differ between runs")
                     self.assertEqual(archive_arrays(name + ".h5"), archive_arrays(names[0] + ".h5"))
 
+    def test_threads_change_no_byte(self):
+        # The polynomial stage sums fixed slices of a rank's tets on --threads threads; by default
+        # as many as the cores the process may run on (its affinity: taskset narrows it; mpirun's
+        # binding gave the 1-rank bake above one), at most four (the slices).
+        args = [self.beam, "--fix", "x<min+1e-9", "--E", "1e6", "--nu", "0.45", "--density", "1000", "--modes", "6",
+                "--rank", "12", "--no-fidelity"]
+        alone = lambda *extra: subprocess.run([BAKE, *args, *extra], capture_output=True, text=True, timeout=300,
+                                              stdin=subprocess.DEVNULL)
+        cores = min(4, len(os.sched_getaffinity(0)))
+        runs = {"default": alone("-o", os.path.join(self.dir, "threads_default")),
+                "one core": subprocess.run(["taskset", "-c", str(min(os.sched_getaffinity(0))), BAKE, *args, "-o",
+                                            os.path.join(self.dir, "threads_one_core")],
+                                           capture_output=True, text=True, timeout=300, stdin=subprocess.DEVNULL),
+                "three": alone("--threads", "3", "-o", os.path.join(self.dir, "threads_three"))}
+        said = {"default": f"{cores} thread{'s' if cores > 1 else ''} per rank", "one core": "1 thread per rank",
+                "three": "3 threads per rank"}
+        digest = lambda name: hashlib.sha256(open(name + ".qvr", "rb").read()).hexdigest()
+        for label, p in runs.items():
+            with self.subTest(label):
+                self.assertEqual(p.returncode, 0, p.stderr)
+                line = next(l for l in p.stdout.splitlines() if "polynomials:" in l)
+                self.assertIn(said[label], line)
+                name = os.path.join(self.dir, "threads_" + label.replace(" ", "_"))
+                self.assertEqual(digest(name), digest(self.results[1][1]))
+        for bad in ("0", "-2", "two"):
+            p = alone("--threads", bad, "-o", os.path.join(self.dir, "threads_bad"))
+            self.assertNotEqual(p.returncode, 0)
+            self.assertIn(f"--threads: expected a positive number, not '{bad}'", p.stderr + p.stdout)
+
     def test_blas_kernels_follow_the_cpu(self):
         # OpenBLAS on a CPU it does not know picks its SSE3 kernels; OPENBLAS_CORETYPE=Prescott stands
         # for that here. With QUIVER_BLAS_CORE=auto the bake chooses by the CPU's features and runs

@@ -4,11 +4,15 @@
 // test (not the runtime's evaluator, which is tested against the same references elsewhere).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstring>
 #include <mpi.h>
 #include <random>
 
 #include "common/box_mesh.h"
+#include "common/reduced_energy.h"
 #include "common/stvk_force_model.h"
+#include "formats/model/qvr_writer.h"
 #include "precompute/stages/partition.h"
 #include "precompute/stages/polynomials.h"
 
@@ -151,4 +155,37 @@ TEST(EnergyPolynomial, BlockSizeChangesOnlyRoundOff) {
     const Eigen::Map<const Eigen::VectorXd> vc(c.data(), c.size());
     EXPECT_LT((va - vc).norm(), 1e-12 * va.norm());
   }
+}
+
+// A rank's tets are summed in fixed slices, each in a Gram of its own, added in slice order: any
+// number of threads gives the same bits, and the sum agrees with one Gram over all tets.
+TEST(EnergyPolynomial, ThreadsChangeNoBit) {
+  const int r = 6;
+  Body s = makeBody(r);
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  const size_t mine = static_cast<size_t>(std::count(s.partition.tetPart.begin(), s.partition.tetPart.end(), rank));
+  ASSERT_EQ(gramSlices(ReducedEnergyRows::columns(r), mine), 4) << "too few tets to slice: the test would test nothing";
+  PolynomialSettings settings;
+  settings.tetsPerBlock = 3;  // several blocks per slice
+  std::vector<double> first;
+  for (int threads : {1, 2, 3, 4, 9}) {
+    settings.threads = threads;
+    int64_t reported = 0;
+    settings.progress = [&](int64_t done, int64_t total) {
+      EXPECT_GT(done, reported);
+      EXPECT_LE(done, total);
+      reported = done;
+    };
+    const auto c = computeEnergyPolynomial(MPI_COMM_WORLD, s.mesh, s.perTet, s.partition.tetPart, s.U, settings).coefficients;
+    EXPECT_GT(reported, 0) << threads << " threads: no progress reported";
+    if (first.empty())
+      first = c;
+    else
+      EXPECT_EQ(std::memcmp(c.data(), first.data(), sizeof(double) * c.size()), 0) << threads << " threads";
+  }
+  const Eigen::MatrixXd gram = reducedEnergyGram(s.mesh, s.perTet, s.U);
+  const std::vector<double> whole = energyCoefficientsFromGram(gram.data(), static_cast<int>(gram.rows()), r);
+  const Eigen::Map<const Eigen::VectorXd> vf(first.data(), first.size()), vw(whole.data(), whole.size());
+  EXPECT_LT((vf - vw).norm(), 1e-12 * vw.norm());
 }
