@@ -13,6 +13,7 @@
 #include "common/vertex_selector.h"
 #include "formats/atomic_file.h"
 #include "formats/mesh/write_mesh.h"
+#include "formats/xml_text.h"
 
 namespace quiver::app {
 
@@ -163,12 +164,12 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
         }
         writeFileAtomically(o.output + name, formatVtu(mesh, {field}));
         const std::string entry = "<DataSet timestep=\"" + std::to_string((step + 1) * h) + "\" part=\"" + std::to_string(body) + "\" file=\"";
-        pvd += entry + stem + name + "\"/>\n";
+        pvd += entry + escapeXml(stem + name) + "\"/>\n";
         if (renderTriangles.empty()) continue;
         std::vector<float> positions, normals;
         target.renderFrame(body, positions, normals);
         writeFileAtomically(o.output + "_render" + name, formatTriangleVtu(positions, renderTriangles, normals));
-        renderPvd += entry + stem + "_render" + name + "\"/>\n";
+        renderPvd += entry + escapeXml(stem + "_render" + name) + "\"/>\n";
       }
   }
   if (!o.output.empty()) {

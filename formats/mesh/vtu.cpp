@@ -13,6 +13,7 @@
 #include "formats/mesh/text_cursor.h"
 #include "formats/mesh/vtk_common.h"
 #include "formats/mesh/write_mesh.h"
+#include "formats/xml_text.h"
 
 namespace quiver {
 
@@ -389,20 +390,6 @@ RawMesh parseVtu(std::string_view bytes, const std::string& file) {
 }
 
 namespace {
-
-std::string escapeXml(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-    case '&': out += "&amp;"; break;
-    case '<': out += "&lt;"; break;
-    case '>': out += "&gt;"; break;
-    case '"': out += "&quot;"; break;
-    default: out += c;
-    }
-  }
-  return out;
-}
 
 // Writes DataArrays inline (ascii) or into the appended block (raw, UInt64 byte-count headers,
 // this machine's byte order).

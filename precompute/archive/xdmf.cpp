@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "formats/atomic_file.h"
+#include "formats/xml_text.h"
 
 // Layout, chosen for ParaView's XDMF 3 readers (Xdmf3ReaderS and Xdmf3ReaderT) and checked with
 // ParaView 5.11's pvpython (values per time step, and Warp By Vector):
@@ -29,21 +30,6 @@
 namespace quiver {
 
 namespace {
-
-std::string escapeXml(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-    case '&': out += "&amp;"; break;
-    case '<': out += "&lt;"; break;
-    case '>': out += "&gt;"; break;
-    case '"': out += "&quot;"; break;
-    case '\'': out += "&apos;"; break;
-    default: out += c;
-    }
-  }
-  return out;
-}
 
 // "/modes/vectors" -> "modes"; a dataset directly under the root is named after itself.
 std::string fieldName(const std::string& datasetPath) {

@@ -7,6 +7,7 @@ import os
 import subprocess
 import tempfile
 import unittest
+import xml.etree.ElementTree
 
 import numpy as np
 
@@ -161,6 +162,12 @@ class QuiverSim(OnTheBakedModel):
         # "-o NAME.pvd" names the series as "-o NAME" does (it once wrote NAME.pvd.pvd).
         self.sim("--steps", 2, "-o", out + "2.pvd")
         self.assertTrue(os.path.exists(out + "2.pvd") and os.path.exists(out + "2.csv"))
+        # A name with XML's own characters: the .pvd still parses and names the frames written.
+        odd = os.path.join(self.tmp.name, "run", "a&b\"<c>'d")
+        self.sim("--steps", 2, "-o", odd)
+        files = [d.get("file") for d in xml.etree.ElementTree.parse(odd + ".pvd").getroot().iter("DataSet")]
+        self.assertEqual(files, ["a&b\"<c>'d_00001.vtu", "a&b\"<c>'d_00002.vtu"])
+        self.assertTrue(all(os.path.exists(os.path.join(self.tmp.name, "run", f)) for f in files))
         try:
             import meshio
         except ImportError:
