@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
       ->check(app::Positive);
   app.add_option("--min-dihedral", s.surface.mesher.minDihedral,
                  "A surface input: the smallest dihedral angle every tet must reach, degrees (checked)")
-      ->check(CLI::Range(0.0, 60.0))->capture_default_str();
+      ->check(app::Between(0.0, 60.0))->capture_default_str();
   app.add_flag("--no-fill-holes{false}", s.surface.checks.fillHoles,
                "A surface input: refuse holes instead of closing each with a fan around its centre");
   app.add_option("--render-mesh", s.surface.renderMesh,
@@ -82,8 +82,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--damping-ratio", s.output.model.dampingRatio,
                  "Default damping stored in NAME.qvr: fraction of critical at the first mode (stiffness-proportional)")
+      ->check(app::NonNegative)
       ->capture_default_str();
-  app.add_option("--time-step", s.output.model.timeStep, "Suggested time step stored in NAME.qvr, in s")->capture_default_str();
+  app.add_option("--time-step", s.output.model.timeStep, "Suggested time step stored in NAME.qvr, in s")
+      ->check(app::Positive)
+      ->capture_default_str();
   app.add_option("--fidelity-max-tets", s.fidelity.maxTets,
                  "Run the fidelity report only on meshes of at most this many tets (larger: skipped, saying so)")
       ->check(app::NonNegative)

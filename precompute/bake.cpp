@@ -120,8 +120,10 @@ void checkBakeSettings(const BakeSettings& s) {
   if (s.output.name.empty()) throw std::invalid_argument("-o NAME is required");
   if (s.output.model.basisPrecision != 32 && s.output.model.basisPrecision != 64)
     throw std::invalid_argument("--basis-precision must be 32 or 64");
-  if (!(s.output.model.dampingRatio >= 0)) throw std::invalid_argument("--damping-ratio must be >= 0");
-  if (!(s.output.model.timeStep > 0)) throw std::invalid_argument("--time-step must be > 0 s");
+  if (!(s.output.model.dampingRatio >= 0 && std::isfinite(s.output.model.dampingRatio)))
+    throw std::invalid_argument("--damping-ratio must be finite and >= 0");
+  if (!(s.output.model.timeStep > 0 && std::isfinite(s.output.model.timeStep)))
+    throw std::invalid_argument("--time-step must be finite and > 0 s");
   const fs::path folder = fs::path(s.output.name).parent_path();
   if (!folder.empty() && !fs::is_directory(folder))
     throw std::invalid_argument("output folder '" + folder.string() + "' does not exist");

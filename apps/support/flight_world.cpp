@@ -62,7 +62,7 @@ void FlightSetup::addTo(CLI::App& app) {
   app.add_option("--friction", friction, "Free flight: Coulomb friction of the colliders")->capture_default_str()->check(NonNegative);
   app.add_option("--restitution", restitution, "Free flight: restitution of the colliders, 0..1")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(Between(0.0, 1.0));
   app.add_flag("--spread", spread, "Free flight, --pile: the N copies side by side on a square grid, apart, not piled");
   app.add_option("--sleep-speed", sleepSpeed,
                  "Free flight, --pile: bodies that could touch, all slower than this (m/s) for half a second, sleep "

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <sstream>
 
@@ -18,7 +19,7 @@ void MeshOptions::addTo(CLI::App& app, const std::string& meshHelp) {
   app.add_option("--degenerate-tolerance", checks.degenerateTolerance,
                  "Refuse tets whose normalised volume 6*sqrt(2)*V/l_rms^3 (1 = regular tet) is below this")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(Between(0.0, 1.0));
 }
 
 CheckedMesh MeshOptions::load(const std::string& tool) const {
@@ -76,7 +77,7 @@ bool parseNumber(const std::string& text, double& value) {
 
 namespace {
 
-CLI::Validator numberWhere(bool (*holds)(double), const std::string& expected, const std::string& name) {
+CLI::Validator numberWhere(std::function<bool(double)> holds, const std::string& expected, const std::string& name) {
   return CLI::Validator(
       [holds, expected](std::string& text) -> std::string {
         double value = 0;
@@ -91,6 +92,13 @@ const CLI::Validator Positive = numberWhere([](double x) { return x > 0 && std::
 const CLI::Validator NonNegative =
     numberWhere([](double x) { return x >= 0 && std::isfinite(x); }, "a number >= 0", "NON-NEGATIVE");
 const CLI::Validator Finite = numberWhere([](double x) { return std::isfinite(x); }, "a finite number", "FINITE");
+
+CLI::Validator Between(double low, double high) {
+  std::ostringstream range;
+  range << low << " to " << high;
+  return numberWhere([low, high](double x) { return x >= low && x <= high; }, "a number from " + range.str(),
+                     "FLOAT in [" + range.str() + "]");
+}
 
 CLI::Validator OutputName(std::vector<std::string> extensions) {
   return CLI::Validator(

@@ -47,6 +47,8 @@ extern const CLI::Validator Positive;
 extern const CLI::Validator NonNegative;
 // Any finite number (a vector option checks each of its values).
 extern const CLI::Validator Finite;
+// A number from `low` to `high`: CLI::Range lets NaN through (no comparison with it fails).
+CLI::Validator Between(double low, double high);
 
 // An output NAME the tool extends itself (NAME.qvr, NAME.h5, ...): drops one of `extensions` the
 // user gave, so that "-o model.qvr" writes model.qvr, not model.qvr.qvr.

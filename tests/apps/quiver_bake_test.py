@@ -146,10 +146,20 @@ class QuiverBake(unittest.TestCase):
                 self.assertIn(said[label], line)
                 name = os.path.join(self.dir, "threads_" + label.replace(" ", "_"))
                 self.assertEqual(digest(name), digest(self.results[1][1]))
-        for bad in ("0", "-2", "two"):
-            p = alone("--threads", bad, "-o", os.path.join(self.dir, "threads_bad"))
-            self.assertNotEqual(p.returncode, 0)
-            self.assertIn(f"--threads: expected a positive number, not '{bad}'", p.stderr + p.stdout)
+
+    def test_options_out_of_range_are_refused_by_the_command_line(self):
+        # Before any work: --time-step inf was once refused only by the export, after every stage.
+        cases = [("--threads", "0", "a positive number"), ("--threads", "-2", "a positive number"),
+                 ("--threads", "two", "a positive number"), ("--time-step", "inf", "a positive number"),
+                 ("--damping-ratio", "inf", "a number >= 0"), ("--degenerate-tolerance", "nan", "a number from 0 to 1"),
+                 ("--min-dihedral", "nan", "a number from 0 to 60")]
+        for option, value, expected in cases:
+            with self.subTest(option=option, value=value):
+                p = subprocess.run([BAKE, self.beam, option, value, "-o", os.path.join(self.dir, "refused")],
+                                   capture_output=True, text=True, timeout=60, stdin=subprocess.DEVNULL)
+                self.assertNotEqual(p.returncode, 0)
+                self.assertIn(f"{option}: expected {expected}, not '{value}'", p.stderr + p.stdout)
+                self.assertNotIn("quiver-bake: mesh:", p.stdout)
 
     def test_blas_kernels_follow_the_cpu(self):
         # OpenBLAS on a CPU it does not know picks its SSE3 kernels; OPENBLAS_CORETYPE=Prescott stands
