@@ -43,8 +43,21 @@ qv_allocator allocatorOr(const qv_allocator* allocator) {
   return heap;
 }
 
+// A caller's allocator needs both functions: one missing was called as address 0.
+bool validAllocator(const qv_allocator* allocator) { return !allocator || (allocator->allocate && allocator->release); }
+
 void report(char* message, size_t size, const std::string& text) {
   if (message && size > 0) std::snprintf(message, size, "%s", text.c_str());
+}
+
+// What is wrong with these arguments of qv_model_load_*, or "" when nothing is.
+std::string modelArgumentsError(const qv_model_config& config, const qv_allocator* allocator) {
+  if (config.coefficient_precision != 32 && config.coefficient_precision != 64)
+    return "qv_model_config.coefficient_precision is " + std::to_string(config.coefficient_precision) + ", not 32 or 64";
+  if (config.group_layout < -1 || config.group_layout > 1)
+    return "qv_model_config.group_layout is " + std::to_string(config.group_layout) + ", not -1, 0 or 1";
+  if (!validAllocator(allocator)) return "the qv_allocator has no allocate or no release function";
+  return "";
 }
 
 bool validVertex(const qv_instance* s, int vertex) { return vertex >= 0 && vertex < s->model->info.vertex_count; }
@@ -132,9 +145,12 @@ qv_result qv_model_load_memory(const void* data, size_t size, const qv_model_con
   qv_model_config defaults;
   qv_model_config_init(&defaults);
   const qv_model_config& settings = config ? *config : defaults;
-  if ((!data && size) || (settings.coefficient_precision != 32 && settings.coefficient_precision != 64) ||
-      settings.group_layout < -1 || settings.group_layout > 1)
+  std::string bad = modelArgumentsError(settings, allocator);
+  if (!data && size) bad = "no data, but a size of " + std::to_string(size) + " bytes";
+  if (!bad.empty()) {
+    report(message, message_size, bad);
     return QV_ERROR_INVALID_ARGUMENT;
+  }
   const qv_allocator use = allocatorOr(allocator);
   // The reader wants an 8-byte aligned image; a caller's buffer may not be.
   void* aligned = nullptr;
@@ -153,6 +169,12 @@ qv_result qv_model_load_file(const char* path, const qv_model_config* config, co
                              qv_model** model, char* message, size_t message_size) {
   if (!model || !path) return QV_ERROR_INVALID_ARGUMENT;
   *model = nullptr;
+  qv_model_config defaults;
+  qv_model_config_init(&defaults);
+  if (const std::string bad = modelArgumentsError(config ? *config : defaults, allocator); !bad.empty()) {
+    report(message, message_size, std::string(path) + ": " + bad);
+    return QV_ERROR_INVALID_ARGUMENT;
+  }
   const qv_allocator use = allocatorOr(allocator);
   // fopen() opens a directory, whose size then reads as LONG_MAX.
   std::error_code error;
@@ -255,7 +277,7 @@ qv_result qv_instance_create(const qv_model* model, const qv_instance_config* co
                              qv_instance** instance) {
   if (!instance) return QV_ERROR_INVALID_ARGUMENT;
   *instance = nullptr;
-  if (!validConfig(model, config)) return QV_ERROR_INVALID_ARGUMENT;
+  if (!validConfig(model, config) || !validAllocator(allocator)) return QV_ERROR_INVALID_ARGUMENT;
   const qv_allocator use = allocatorOr(allocator);
   char* block = static_cast<char*>(use.allocate(instanceBytes(*model, *config), 64, use.user));
   if (!block) return QV_ERROR_OUT_OF_MEMORY;
@@ -320,8 +342,9 @@ void qv_instance_set_gravity(qv_instance* s, const double g[3]) {
 
 qv_result qv_instance_set_constraint(qv_instance* s, int slot, const int* vertices, int count, const double* targets,
                                      double stiffness) {
-  if (!s || s->flying() || slot < 0 || slot >= s->config.max_constraints || count < 1 || !vertices || !targets || !(stiffness > 0) ||
-      !validVertices(s, vertices, count))
+  if (!s || s->flying() || slot < 0 || slot >= s->config.max_constraints || count < 1 || !vertices || !targets ||
+      !(stiffness > 0 && std::isfinite(stiffness)) || !validVertices(s, vertices, count) ||
+      !std::all_of(targets, targets + 3 * static_cast<size_t>(count), [](double x) { return std::isfinite(x); }))
     return QV_ERROR_INVALID_ARGUMENT;
   s->loads.setConstraint(*s->model, slot, vertices, count, targets, stiffness);
   return QV_OK;
@@ -444,7 +467,12 @@ qv_result qv_triangle_mesh_create(const double* positions, int vertex_count, con
                                   const qv_allocator* allocator, qv_triangle_mesh** mesh, char* message, size_t message_size) {
   if (!mesh) return QV_ERROR_INVALID_ARGUMENT;
   *mesh = nullptr;
-  if (!positions || !triangles || vertex_count < 0 || triangle_count < 0) return QV_ERROR_INVALID_ARGUMENT;
+  if (!positions || !triangles || vertex_count < 0 || triangle_count < 0 || !validAllocator(allocator)) {
+    report(message, message_size, !validAllocator(allocator) ? "the qv_allocator has no allocate or no release function"
+                                  : !positions || !triangles ? "no positions or no triangles"
+                                                             : "a negative vertex or triangle count");
+    return QV_ERROR_INVALID_ARGUMENT;
+  }
   return createTriangleMesh(positions, vertex_count, triangles, triangle_count, allocatorOr(allocator), mesh, message,
                             message_size);
 }
@@ -463,7 +491,7 @@ qv_result qv_world_create(const qv_world_config* config, const qv_allocator* all
   qv_world_config settings;
   defaultWorldConfig(settings);
   if (config) settings = *config;
-  if (!validWorldConfig(settings)) return QV_ERROR_INVALID_ARGUMENT;
+  if (!validWorldConfig(settings) || !validAllocator(allocator)) return QV_ERROR_INVALID_ARGUMENT;
   *world = createWorld(settings, allocatorOr(allocator));
   return *world ? QV_OK : QV_ERROR_OUT_OF_MEMORY;
 }

@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <string>
 
 #include "tests/runtime/runtime_fixture.h"
 
@@ -151,8 +154,56 @@ TEST(RealTime, BadArgumentsAreRefusedNotCrashed) {
   const int v = 0;
   EXPECT_EQ(qv_instance_set_constraint(s, config.max_constraints, &v, 1, f, 1), QV_ERROR_INVALID_ARGUMENT);
   EXPECT_EQ(qv_instance_set_constraint(s, 0, &v, 1, f, -1), QV_ERROR_INVALID_ARGUMENT);
+  // Non-finite springs and targets (an infinite stiffness was taken, and every step then reset).
+  EXPECT_EQ(qv_instance_set_constraint(s, 0, &v, 1, f, INFINITY), QV_ERROR_INVALID_ARGUMENT);
+  const double far[3] = {1, NAN, 0};
+  EXPECT_EQ(qv_instance_set_constraint(s, 0, &v, 1, far, 1), QV_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(qv_instance_set_constraint(s, 0, &v, 1, f, 1), QV_OK);
   qv_instance_destroy(s);
   qv_model* model = nullptr;
   EXPECT_EQ(qv_model_load_memory("not a model", 11, nullptr, nullptr, &model, nullptr, 0), QV_ERROR_FORMAT);
   EXPECT_EQ(model, nullptr);
+  // Invalid arguments say which, in the message (it was left as it was), for memory and file alike.
+  qv_model_config precision;
+  qv_model_config_init(&precision);
+  precision.coefficient_precision = 16;
+  qv_model_config layout;
+  qv_model_config_init(&layout);
+  layout.group_layout = 7;
+  qv_allocator half;
+  qv_allocator_init(&half);
+  half.allocate = nullptr;  // was called as address 0
+  const struct {
+    const qv_model_config* config;
+    const qv_allocator* allocator;
+    const char* says;
+  } cases[] = {{&precision, nullptr, "coefficient_precision is 16, not 32 or 64"},
+               {&layout, nullptr, "group_layout is 7, not -1, 0 or 1"},
+               {nullptr, &half, "qv_allocator has no allocate or no release function"}};
+  for (const auto& c : cases) {
+    char message[256];
+    std::memset(message, 'x', sizeof message);
+    EXPECT_EQ(qv_model_load_memory("not a model", 11, c.config, c.allocator, &model, message, sizeof message),
+              QV_ERROR_INVALID_ARGUMENT);
+    EXPECT_NE(std::strstr(message, c.says), nullptr) << std::string(message, strnlen(message, sizeof message));
+    std::memset(message, 'x', sizeof message);
+    EXPECT_EQ(qv_model_load_file(QUIVER_RUNTIME_MODEL, c.config, c.allocator, &model, message, sizeof message),
+              QV_ERROR_INVALID_ARGUMENT);
+    EXPECT_NE(std::strstr(message, c.says), nullptr) << std::string(message, strnlen(message, sizeof message));
+    EXPECT_NE(std::strstr(message, QUIVER_RUNTIME_MODEL), nullptr);
+    EXPECT_EQ(model, nullptr);
+  }
+  EXPECT_EQ(qv_instance_create(m.model, &config, &half, &s), QV_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(s, nullptr);
+  // A triangle mesh's bad counts are said too (the message held the previous call's).
+  char message[128] = "previous";
+  qv_triangle_mesh* mesh = nullptr;
+  const double positions[3] = {0, 0, 0};
+  const int triangles[3] = {0, 0, 0};
+  EXPECT_EQ(qv_triangle_mesh_create(positions, -4, triangles, 1, nullptr, &mesh, message, sizeof message),
+            QV_ERROR_INVALID_ARGUMENT);
+  EXPECT_STREQ(message, "a negative vertex or triangle count");
+  qv_world* world = nullptr;
+  EXPECT_EQ(qv_world_create(nullptr, &half, &world), QV_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(world, nullptr);
 }

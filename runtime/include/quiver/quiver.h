@@ -92,9 +92,10 @@ typedef struct qv_model_config {
 QV_API void qv_model_config_init(qv_model_config* config);
 
 /* Loads a .qvr file or a .qvr image in memory (copied; the caller may free it afterwards).
-   `config` and `allocator` may be NULL for the defaults and the C heap. On failure *model is NULL and, when `message` is not
-   NULL, it receives a NUL-terminated description (file, section, offset, what is wrong),
-   truncated to `message_size` bytes. */
+   `config` and `allocator` may be NULL for the defaults and the C heap (an allocator given needs both
+   functions). On failure *model is NULL and, when `message` is not NULL, it receives a NUL-terminated
+   description (file, section, offset, what is wrong; or which argument is invalid), truncated to
+   `message_size` bytes. */
 QV_API qv_result qv_model_load_file(const char* path, const qv_model_config* config, const qv_allocator* allocator,
                                     qv_model** model, char* message, size_t message_size);
 QV_API qv_result qv_model_load_memory(const void* data, size_t size, const qv_model_config* config,
@@ -302,7 +303,7 @@ QV_API qv_result qv_instances_step(qv_instance* const* instances, int count, con
 /* Loads. Per-step (cleared by each step): a force on one vertex (N), a reduced force (r values).
    Persistent: gravity (m/s^2), and penalty constraints pulling vertices toward targets with a
    spring of `stiffness` (N/m) per vertex: one vertex dragged by the mouse, or a group held at
-   positions that a caller moves and rotates (drag and twist). */
+   positions that a caller moves and rotates (drag and twist). Targets and stiffness must be finite. */
 QV_API qv_result qv_instance_add_vertex_force(qv_instance* instance, int vertex, const double force[3]);
 QV_API qv_result qv_instance_add_reduced_force(qv_instance* instance, const double* force);
 QV_API void qv_instance_set_gravity(qv_instance* instance, const double acceleration[3]);
