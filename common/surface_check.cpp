@@ -259,7 +259,10 @@ CheckedSurface checkSurface(const std::vector<double>& inputPositions, const std
   Eigen::AlignedBox3d box;
   for (const auto& t : byPiece[main])
     for (int v : t) box.extend(at(positions, v));
-  if (!(volume[main] > 1e-9 * box.diagonal().prod()))
+  // Against the cube of the box's diagonal, not the product of its sides: that is zero for a flat
+  // sheet, whose closed holes enclose a rounding error's volume (a flat concave 64-gon passed, and
+  // gmsh then ran for ever on it).
+  if (!(volume[main] > 1e-9 * std::pow(box.diagonal().norm(), 3)))
     fail("encloses no volume (" + std::to_string(volume[main]) + "): a flat or open sheet, not a solid");
   // Pieces inside the main one, and small ones outside it (decorations: under 5% of its volume),
   // are set aside: a render mesh carries them with the nearest tets.

@@ -62,6 +62,19 @@ TEST(ReadSurface, WhatIsNotASurfaceIsNamed) {
             std::string::npos);
 }
 
+// Debian's concave_polygon.obj is one flat concave 64-gon, a sheet: with its holes closed it
+// encloses a rounding error's volume. Compared with the product of its box's sides, zero for a
+// flat box, that passed, and gmsh then ran for ever on it.
+TEST(ReadSurface, AFlatPolygonWithItsHolesClosedEnclosesNoVolume) {
+  const std::string path = "/usr/share/assimp/models/OBJ/concave_polygon.obj";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "Debian's assimp-testmodels is not installed: " << path;
+  const SurfaceMesh s = readSurfaceFile(path);
+  SurfaceCheckOptions options;
+  options.fillHoles = true;
+  EXPECT_NE(test::errorOf<MeshError>([&] { checkSurface(s.positions, s.triangles, path, options); }).find("encloses no volume"),
+            std::string::npos);
+}
+
 TEST(ReadSurface, ANonFiniteObjCoordinateIsNamedAtItsLine) {
   // Assimp numbers the vertices of its faces' corners, so its index named no line of the file.
   const std::string text = "# a tetrahedron\nv 0 0 0\nv 1 0 0\n\nv 0 nan 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n";
