@@ -1,5 +1,7 @@
 // quiver: inspect and evaluate baked runtime models (.qvr). Built on the runtime library alone:
 // what it prints is what a game embedding the runtime would compute.
+#include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <sstream>
 #include <vector>
@@ -52,6 +54,8 @@ std::vector<double> parseQ(const std::string& text, int r) {
   }
   if (static_cast<int>(q.size()) != r)
     throw std::runtime_error("--q has " + std::to_string(q.size()) + " values; the model has r = " + std::to_string(r));
+  for (size_t k = 0; k < q.size(); ++k)
+    if (!std::isfinite(q[k])) throw std::runtime_error("--q: value " + std::to_string(k) + " is not finite");
   return q;
 }
 
@@ -134,6 +138,10 @@ ordered_json evaluateModel(const quiver::app::RuntimeModel& model, const std::st
       stiffness(static_cast<size_t>(r) * r);
   double energy = 0;
   qv_model_evaluate(model.get(), q.data(), &energy, force.data(), stiffness.data(), scratch.data());
+  // A finite q far beyond the model's range (the energy is quartic in it) overflows.
+  if (!std::isfinite(energy) || !std::all_of(force.begin(), force.end(), [](double f) { return std::isfinite(f); }) ||
+      !std::all_of(stiffness.begin(), stiffness.end(), [](double k) { return std::isfinite(k); }))
+    throw std::runtime_error("--q is too large: the energy, force or stiffness there overflows a double");
   ordered_json out;
   out["energy"] = energy;
   out["force"] = force;

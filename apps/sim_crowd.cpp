@@ -119,6 +119,10 @@ int simulateCrowd(const std::string& path, const SimOptions& o, const CrowdOptio
               << " ms, p99 " << p99 << " ms per frame" << (resets ? ", " + std::to_string(resets) + " resets" : std::string())
               << "\n";
   }
+  if (resets > 0)
+    std::cerr << "quiver sim: warning: the instances' states went non-finite " << resets
+              << " times and the runtime reset them to rest (exit code 2): the load is too large for this model or "
+                 "this time step\n";
   return resets > 0 ? 2 : 0;
 }
 

@@ -104,7 +104,10 @@ class QuiverModel(unittest.TestCase):
 
     def test_bad_arguments_and_damaged_files_are_refused_clearly(self):
         model = self.full + ".qvr"
-        for q, message in (("1,2", "the model has r = 12"), ("1,x," + "0," * 9 + "0", "'x' is not a number")):
+        # Non-finite or overflowing q once printed null energies and forces with exit code 0.
+        for q, message in (("1,2", "the model has r = 12"), ("1,x," + "0," * 9 + "0", "'x' is not a number"),
+                           ("0,nan," + "0," * 9 + "0", "--q: value 1 is not finite"),
+                           ("1e200," + "0," * 10 + "0", "--q is too large: the energy, force or stiffness there overflows")):
             p = quiver("eval", model, "--q", q, ok=False)
             self.assertEqual(p.returncode, 1)
             self.assertIn(message, p.stderr)
@@ -221,6 +224,11 @@ class QuiverSim(OnTheBakedModel):
         p = self.sim("--force", "0,0,-1e300", "--steps", "5", ok=False)
         self.assertEqual(p.returncode, 2)
         self.assertIn("went non-finite 5 times and the runtime reset it to rest", p.stderr)
+        # A crowd says so too (it exited 2 in silence).
+        p = self.sim("--force", "0,0,-1e300", "--steps", "5", "--instances", "3", "--json", ok=False)
+        self.assertEqual(p.returncode, 2)
+        self.assertEqual(json.loads(p.stdout)["resets"], 15)
+        self.assertIn("states went non-finite 15 times and the runtime reset them to rest", p.stderr)
 
 
 class QuiverRender(OnTheBakedModel):
