@@ -78,6 +78,21 @@ DirectSolver::DirectSolver(Mat A, const DofLayout& layout) : layout_(layout) {
 
 DirectSolver::~DirectSolver() = default;
 
+const DirectSolver& StiffnessFactor::get() {
+  if (solver_) return *solver_;
+  try {
+    solver_ = std::make_unique<DirectSolver>(stiffness_, layout_);
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    if (what.rfind("the matrix to factor is not positive definite", 0) != 0) throw;
+    // Said in the factor's terms alone ("3 negative pivots"), it left users guessing.
+    throw std::runtime_error("the rest stiffness K is singular: the fixed vertices leave the object free to move "
+                             "rigidly (fix at least three vertices not on one line, or none for a free object) (" +
+                             what + ")");
+  }
+  return *solver_;
+}
+
 Eigen::MatrixXd DirectSolver::solve(const Eigen::MatrixXd& B, Eigen::Index round,
                                     const ProgressCallback& progress) const {
   const Eigen::Index total = B.cols();

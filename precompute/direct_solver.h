@@ -54,10 +54,8 @@ private:
 class StiffnessFactor {
 public:
   StiffnessFactor(Mat stiffness, const DofLayout& layout) : stiffness_(stiffness), layout_(layout) {}
-  const DirectSolver& get() {
-    if (!solver_) solver_ = std::make_unique<DirectSolver>(stiffness_, layout_);
-    return *solver_;
-  }
+  // Throws, where K is not positive definite, what makes a fixed object's K singular.
+  const DirectSolver& get();
   void release() { solver_.reset(); }
 
 private:

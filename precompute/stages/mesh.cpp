@@ -9,6 +9,50 @@
 
 namespace quiver {
 
+namespace {
+
+// The mesh's pieces (tets joined through shared vertices): each must be held by a fixed vertex,
+// or, for a free object, be the only one; else K has more null directions than the rigid motions
+// the bake accounts for, and the factorisation failed saying only "negative pivots".
+void checkPieces(const MeshInputs& in, const std::string& path) {
+  const TetMesh& m = in.mesh.mesh;
+  std::vector<int> parent(static_cast<size_t>(m.vertexCount()));
+  for (size_t v = 0; v < parent.size(); ++v) parent[v] = static_cast<int>(v);
+  const auto root = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const Tet& t : m.tets)
+    for (int k = 1; k < 4; ++k) parent[root(t[k])] = root(t[0]);
+  std::vector<char> held(parent.size(), 0);
+  for (int v : in.fixed) held[root(v)] = 1;
+  int pieces = 0, loose = 0, firstLoose = -1;
+  for (int v = 0; v < m.vertexCount(); ++v)
+    if (root(v) == v) {
+      ++pieces;
+      if (!held[v] && !in.freeObject() && loose++ == 0) firstLoose = v;
+    }
+  const auto where = [&](int v) {
+    const Eigen::Vector3d& x = m.vertices[v];
+    char text[160];
+    std::snprintf(text, sizeof text, "vertex %d (%g, %g, %g)", in.mesh.fileVertex[v], x.x(), x.y(), x.z());
+    return std::string(text);
+  };
+  if (in.freeObject() && pieces > 1) {
+    int second = -1;
+    for (int v = 0; v < m.vertexCount() && second < 0; ++v)
+      if (root(v) != root(0)) second = v;
+    throw std::invalid_argument(path + ": " + std::to_string(pieces) + " separate pieces (no vertex joins them), the second at " +
+                                where(second) + ": a free object must be one piece; bake each piece on its own");
+  }
+  if (loose > 0)
+    throw std::invalid_argument(path + ": " + std::to_string(pieces) + " separate pieces (no vertex joins them), " +
+                                std::to_string(loose) + " of them with no fixed vertex, the first at " + where(firstLoose) +
+                                ": fix vertices of every piece, or bake each piece on its own");
+}
+
+} // namespace
+
 MeshInputs loadMeshInputs(const MeshSettings& s) {
   MeshInputs in;
   in.mesh = loadMesh(s.path, s.checks);
@@ -21,6 +65,7 @@ MeshInputs loadMeshInputs(const MeshSettings& s) {
   for (const Material& m : in.perTet) h.add(m.youngsModulus).add(m.poissonRatio).add(m.density);
   in.hash = h.hex();
   in.freeDofs = 3 * (static_cast<int64_t>(in.mesh.mesh.vertexCount()) - static_cast<int64_t>(in.fixed.size()));
+  checkPieces(in, s.path);
   return in;
 }
 

@@ -226,6 +226,8 @@ class QuiverBake(unittest.TestCase):
             (["--basis-from", os.path.join(self.dir, "beam1.h5:/nothing")], "/nothing"),
             # Read before any work: it once failed only after the modes.
             (["--basis-from", os.path.join(self.dir, "wrong_shape.npy")], "wrong_shape.npy: a basis must have shape"),
+            # One fixed vertex: said in the factor's terms alone ("3 negative pivots"), it left users guessing.
+            (["--fix-indices", "0"], "the rest stiffness K is singular: the fixed vertices leave the object free to move rigidly"),
         ]
         for ranks in (1, 2):
             for extra, message in cases:
@@ -236,6 +238,32 @@ class QuiverBake(unittest.TestCase):
                     self.assertEqual(p.stderr.count("quiver-bake: error:"), 1, p.stderr)
                     self.assertFalse(os.path.exists(os.path.join(self.dir, "bad.h5")))
                     self.assertNotIn("quiver-bake: modes:", p.stdout)
+
+    def test_a_mesh_in_separate_pieces_is_refused_saying_where(self):
+        # Two unit cubes of six tets each, apart: K had more null directions than the bake accounts
+        # for, and the factorisation said "negative pivots".
+        corners = [(x, y, z) for z in (0, 1) for y in (0, 1) for x in (0, 1)]
+        tets = [(0, 1, 3, 7), (0, 1, 5, 7), (0, 2, 3, 7), (0, 2, 6, 7), (0, 4, 5, 7), (0, 4, 6, 7)]
+        path = os.path.join(self.dir, "two_cubes.vtk")
+        with open(path, "w") as f:
+            f.write("# vtk DataFile Version 3.0\ntwo cubes\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 16 double\n")
+            for shift in (0, 3):
+                f.writelines(f"{x + shift} {y} {z}\n" for x, y, z in corners)
+            f.write("CELLS 12 60\n")
+            for base in (0, 8):
+                f.writelines("4 " + " ".join(str(base + v) for v in t) + "\n" for t in tets)
+            f.write("CELL_TYPES 12\n" + "10\n" * 12)
+        for ranks in (1, 2):
+            for extra, message in (([], "2 separate pieces (no vertex joins them), the second at vertex 8 (3, 0, 0): "
+                                        "a free object must be one piece"),
+                                   (["--fix", "x<0.5"], "2 separate pieces (no vertex joins them), 1 of them with no "
+                                                        "fixed vertex, the first at vertex 8 (3, 0, 0)")):
+                with self.subTest(ranks=ranks, extra=extra):
+                    p = bake(ranks, path, "--fix-orientation", "--modes", "2", "--rank", "3", *extra, "-o",
+                             os.path.join(self.dir, "pieces"), timeout=120)
+                    self.assertNotEqual(p.returncode, 0)
+                    self.assertIn(message, p.stderr)
+                    self.assertEqual(p.stderr.count("quiver-bake: error:"), 1, p.stderr)
 
     def test_more_vectors_than_the_recipe_gives_warn_and_bake_the_largest_r(self):
         # "-o NAME.qvr" names the model, as "-o NAME" does (it once wrote fewer.qvr.qvr).
