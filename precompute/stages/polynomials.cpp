@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <exception>
+#include <system_error>
 #include <thread>
 
 #include <cblas.h>
@@ -57,19 +58,25 @@ EnergyPolynomial computeEnergyPolynomial(MPI_Comm comm, const TetMesh& mesh, con
       if (reports && settings.progress) settings.progress(total, static_cast<int64_t>(mine.size()));
     }
   };
-  // Thread k takes slices k, k + threads, ...; the calling thread is thread 0, and reports.
+  // Each thread takes the next slice not yet taken until none is left; the calling thread is
+  // thread 0, and reports. Where the system starts fewer threads than asked, those take more.
   std::vector<std::exception_ptr> failure(threads);
+  std::atomic<int> next{0};
   const auto work = [&](int k) {
     try {
-      for (int s = k; s < slices; s += threads) sumSlice(s, k == 0);
+      for (int s; (s = next++) < slices;) sumSlice(s, k == 0);
     } catch (...) {
       failure[k] = std::current_exception();
     }
   };
   std::vector<std::thread> helpers;
-  for (int k = 1; k < threads; ++k) helpers.emplace_back(work, k);
+  try {
+    for (int k = 1; k < threads; ++k) helpers.emplace_back(work, k);
+  } catch (const std::system_error&) {
+  }
   work(0);
   for (std::thread& helper : helpers) helper.join();
+  if (settings.progress) settings.progress(done, static_cast<int64_t>(mine.size()));  // whichever thread finished
   for (const std::exception_ptr& e : failure)
     if (e) std::rethrow_exception(e);
   for (int s = 1; s < slices; ++s) grams[0] += grams[s];

@@ -27,7 +27,7 @@ struct PolynomialSettings {
   int tetsPerBlock = 32;
   // Threads summing the slices (at most their number, gramSlices()); the calling thread is one.
   int threads = 1;
-  ProgressCallback progress;  // (tets done on this rank, tets of this rank), on the calling thread; optional
+  ProgressCallback progress;  // (tets done on this rank, tets of this rank), on the calling thread, ending at all; optional
 };
 
 // The slices a rank's `tets` are cut into for Grams of N x N: four, fewer where four Grams would
