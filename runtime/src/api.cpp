@@ -45,6 +45,7 @@ qv_allocator allocatorOr(const qv_allocator* allocator) {
 
 // A caller's allocator needs both functions: one missing was called as address 0.
 bool validAllocator(const qv_allocator* allocator) { return !allocator || (allocator->allocate && allocator->release); }
+constexpr const char* kInvalidAllocator = "the qv_allocator has no allocate or no release function";
 
 void report(char* message, size_t size, const std::string& text) {
   if (message && size > 0) std::snprintf(message, size, "%s", text.c_str());
@@ -56,7 +57,7 @@ std::string modelArgumentsError(const qv_model_config& config, const qv_allocato
     return "qv_model_config.coefficient_precision is " + std::to_string(config.coefficient_precision) + ", not 32 or 64";
   if (config.group_layout < -1 || config.group_layout > 1)
     return "qv_model_config.group_layout is " + std::to_string(config.group_layout) + ", not -1, 0 or 1";
-  if (!validAllocator(allocator)) return "the qv_allocator has no allocate or no release function";
+  if (!validAllocator(allocator)) return kInvalidAllocator;
   return "";
 }
 
@@ -467,10 +468,12 @@ qv_result qv_triangle_mesh_create(const double* positions, int vertex_count, con
                                   const qv_allocator* allocator, qv_triangle_mesh** mesh, char* message, size_t message_size) {
   if (!mesh) return QV_ERROR_INVALID_ARGUMENT;
   *mesh = nullptr;
-  if (!positions || !triangles || vertex_count < 0 || triangle_count < 0 || !validAllocator(allocator)) {
-    report(message, message_size, !validAllocator(allocator) ? "the qv_allocator has no allocate or no release function"
-                                  : !positions || !triangles ? "no positions or no triangles"
-                                                             : "a negative vertex or triangle count");
+  const char* bad = !validAllocator(allocator)    ? kInvalidAllocator
+                    : !positions || !triangles      ? "no positions or no triangles"
+                    : vertex_count < 0 || triangle_count < 0 ? "a negative vertex or triangle count"
+                                                              : nullptr;
+  if (bad) {
+    report(message, message_size, bad);
     return QV_ERROR_INVALID_ARGUMENT;
   }
   return createTriangleMesh(positions, vertex_count, triangles, triangle_count, allocatorOr(allocator), mesh, message,
