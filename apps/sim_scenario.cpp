@@ -71,9 +71,9 @@ std::string SimOptions::checkScenarioOption(const std::string& name, const std::
 
 void SimOptions::addTo(CLI::App& app) {
   addScenarioTo(app);
-  app.add_option("-o,--output", output, "Write NAME.pvd with NAME_NNNNN.vtu frames and NAME.csv")
-      ->transform(OutputName({".pvd", ".csv"}));
-  app.add_option("--every", every, "Write every k-th step")->capture_default_str()->check(Positive);
+  CLI::Option* writes = app.add_option("-o,--output", output, "Write NAME.pvd with NAME_NNNNN.vtu frames and NAME.csv")
+                           ->transform(OutputName({".pvd", ".csv"}));
+  app.add_option("--every", every, "Write every k-th step")->capture_default_str()->check(Positive)->needs(writes);
   app.add_flag("--json", json, "Print one JSON summary");
 }
 

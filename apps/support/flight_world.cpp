@@ -76,8 +76,9 @@ void FlightSetup::addTo(CLI::App& app) {
 void FlightSetup::check(bool freeFlight) const {
   const FlightSetup none;
   if (!freeFlight && (position != none.position || velocity != none.velocity || angularVelocity != none.angularVelocity ||
-                      !colliders.empty() || pile != 1))
-    throw std::runtime_error("--position, --velocity, --angular-velocity, --collider and --pile need --free");
+                      !colliders.empty() || pile != 1 || friction != none.friction || restitution != none.restitution))
+    throw std::runtime_error(
+        "--position, --velocity, --angular-velocity, --collider, --pile, --friction and --restitution need --free");
   if (pile == 1 && (spread || sleepSpeed != none.sleepSpeed)) throw std::runtime_error("--spread and --sleep-speed need --pile N");
 }
 

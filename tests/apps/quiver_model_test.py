@@ -213,7 +213,10 @@ class QuiverSim(OnTheBakedModel):
                               (["--drag", "0,0,0.1", "--stiffness", "0"], "--stiffness: expected a positive number"),
                               (["--alpha", "-100"], "--alpha: expected a number >= 0"),
                               (["--beta", "nan"], "--beta: expected a number >= 0"),
-                              (["--hold", "-5"], "--hold: expected a number >= 0")):
+                              (["--hold", "-5"], "--hold: expected a number >= 0"),
+                              # Once ignored in silence: what nothing would write, friction with nothing to touch.
+                              (["--every", "3"], "--every requires --output"),
+                              (["--friction", "0.1"], "need --free"), (["--restitution", "0.9"], "need --free")):
             p = self.sim(*args, ok=False)
             self.assertNotEqual(p.returncode, 0)
             self.assertIn(message, p.stderr)
