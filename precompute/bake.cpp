@@ -127,6 +127,10 @@ void checkBakeSettings(const BakeSettings& s) {
   const fs::path folder = fs::path(s.output.name).parent_path();
   if (!folder.empty() && !fs::is_directory(folder))
     throw std::invalid_argument("output folder '" + folder.string() + "' does not exist");
+  // Found only at the end, a folder in an output's place failed the last rename after the others.
+  for (const char* suffix : {".qvr", ".h5", ".h5.partial", ".xmf"})
+    if (fs::is_directory(s.output.name + suffix))
+      throw std::invalid_argument("output '" + s.output.name + suffix + "' is a folder");
 }
 
 void runBake(const BakeContext& ctx, const BakeSettings& s) {

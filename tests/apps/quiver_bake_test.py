@@ -239,6 +239,16 @@ class QuiverBake(unittest.TestCase):
                     self.assertFalse(os.path.exists(os.path.join(self.dir, "bad.h5")))
                     self.assertNotIn("quiver-bake: modes:", p.stdout)
 
+    def test_a_folder_in_an_outputs_place_is_refused_before_work(self):
+        # Found at the end, it failed the archive's rename after a fresh NAME.qvr had landed.
+        name = os.path.join(self.dir, "taken")
+        os.mkdir(name + ".h5")
+        p = bake(2, self.beam, "-o", name, timeout=120)
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn(f"output '{name}.h5' is a folder", p.stderr)
+        self.assertNotIn("quiver-bake: modes:", p.stdout)
+        self.assertFalse(os.path.exists(name + ".qvr"))
+
     def test_a_mesh_in_separate_pieces_is_refused_saying_where(self):
         # Two unit cubes of six tets each, apart: K had more null directions than the bake accounts
         # for, and the factorisation said "negative pivots".
