@@ -89,8 +89,8 @@ QV_HOT void packedSymmetricProduct(const C* Q, size_t n, const double* x, double
       Vd xs, ys, c, half[2];
       std::memcpy(&xs, x + p + s, sizeof xs);
       // Row by row, so that one converted coefficient vector is live at a time (all eight at once
-      // left no register for the eighth dot product). Unrolled by hand's order: left to GCC, the
-      // AVX-512 clone kept the loop and carried dot, xp and half through the stack (2.3x slower).
+      // left no register for the eighth dot product). Unrolled: left rolled by GCC in the AVX-512
+      // clone, it carried dot, xp and half through the stack (the evaluation about 2x slower).
 #pragma GCC unroll 8
       for (size_t g = 0; g < G; ++g) {
         widen(group + inGroup(g, s), std::make_integer_sequence<int, W>(), c);
