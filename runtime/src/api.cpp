@@ -47,6 +47,13 @@ qv_allocator allocatorOr(const qv_allocator* allocator) {
 bool validAllocator(const qv_allocator* allocator) { return !allocator || (allocator->allocate && allocator->release); }
 constexpr const char* kInvalidAllocator = "the qv_allocator has no allocate or no release function";
 
+qv_model_config modelConfigOr(const qv_model_config* config) {
+  if (config) return *config;
+  qv_model_config defaults;
+  qv_model_config_init(&defaults);
+  return defaults;
+}
+
 void report(char* message, size_t size, const std::string& text) {
   if (message && size > 0) std::snprintf(message, size, "%s", text.c_str());
 }
@@ -143,9 +150,7 @@ qv_result qv_model_load_memory(const void* data, size_t size, const qv_model_con
                                const qv_allocator* allocator, qv_model** model, char* message, size_t message_size) {
   if (!model) return QV_ERROR_INVALID_ARGUMENT;
   *model = nullptr;
-  qv_model_config defaults;
-  qv_model_config_init(&defaults);
-  const qv_model_config& settings = config ? *config : defaults;
+  const qv_model_config settings = modelConfigOr(config);
   std::string bad = modelArgumentsError(settings, allocator);
   if (!data && size) bad = "no data, but a size of " + std::to_string(size) + " bytes";
   if (!bad.empty()) {
@@ -170,9 +175,7 @@ qv_result qv_model_load_file(const char* path, const qv_model_config* config, co
                              qv_model** model, char* message, size_t message_size) {
   if (!model || !path) return QV_ERROR_INVALID_ARGUMENT;
   *model = nullptr;
-  qv_model_config defaults;
-  qv_model_config_init(&defaults);
-  if (const std::string bad = modelArgumentsError(config ? *config : defaults, allocator); !bad.empty()) {
+  if (const std::string bad = modelArgumentsError(modelConfigOr(config), allocator); !bad.empty()) {
     report(message, message_size, std::string(path) + ": " + bad);
     return QV_ERROR_INVALID_ARGUMENT;
   }
