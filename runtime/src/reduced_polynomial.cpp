@@ -180,6 +180,42 @@ QV_HOT double monomialEnergy(const double* c, int r, const double* q, const doub
   return (sum[0] + sum[1]) + (sum[2] + sum[3]);
 }
 
+// K(q) (with K, row-major), R(q) into R and E(q) from the stiffness polynomial's parts per pair
+// (k2, K_3 and K_4: the header's formulas), a row at a time: R_a's own terms as one sum, the other
+// rows' as axpys into R (summed into R_a in memory, one term after another, they waited on a
+// store at every pair), K's upper triangle stored as it comes and mirrored after.
+template <bool withK>
+QV_HOT double assemble(const double* __restrict k2, const double* __restrict y3, const double* __restrict y4, int r,
+                       const double* __restrict q, double* __restrict K, double* __restrict R) {
+  using P = ReducedPolynomial;
+  const auto stiffnessAt = [&](size_t p) { return k2[p] + y3[p] + y4[p]; };
+  const auto forceWeight = [&](size_t p) { return k2[p] + 0.5 * y3[p] + P::kThird * y4[p]; };
+  const auto energyWeight = [&](size_t p) { return 0.5 * k2[p] + P::kSixth * y3[p] + P::kTwelfth * y4[p]; };
+  for (int i = 0; i < r; ++i) R[i] = 0;
+  double e = 0;
+  for (int a = 0; a < r; ++a) {
+    const size_t p = monomialIndex2(r, a, a);
+    const double qa = q[a];
+    if (withK) K[a * r + a] = stiffnessAt(p);
+    double dot = forceWeight(p) * qa, energy = 0;
+#pragma omp simd reduction(+ : dot, energy)
+    for (int b = a + 1; b < r; ++b) {
+      const size_t pb = p + static_cast<size_t>(b - a);
+      if (withK) K[a * r + b] = stiffnessAt(pb);
+      const double f = forceWeight(pb);
+      dot += f * q[b];
+      R[b] += f * qa;
+      energy += energyWeight(pb) * q[b];
+    }
+    R[a] += dot;
+    e += qa * (2 * energy + energyWeight(p) * qa);
+  }
+  if (withK)
+    for (int a = 1; a < r; ++a)
+      for (int b = 0; b < a; ++b) K[a * r + b] = K[b * r + a];
+  return e;
+}
+
 } // namespace
 
 ReducedPolynomial::Arrays ReducedPolynomial::carve(BlockCarver& c, bool single, bool monomials, bool groups) const {
@@ -339,17 +375,8 @@ void ReducedPolynomial::evaluate(const double* q, double* energy, double* force,
   else
     wide ? packedSymmetricProduct<8>(q64_, n, x, y4) : packedSymmetricProduct<4>(q64_, n, x, y4);
   blockedProduct(t_, r, P, q, y3);
-  for (int i = 0; i < r; ++i) Rq[i] = 0;
-  double e = 0;
-  for (int a = 0, p = 0; a < r; ++a)
-    for (int b = a; b < r; ++b, ++p) {
-      const double k2 = k2_[p], s3 = y3[p], s4 = y4[p];
-      if (stiffness) stiffness[a * r + b] = stiffness[b * r + a] = k2 + s3 + s4;
-      const double f = k2 + 0.5 * s3 + kThird * s4, h = 0.5 * k2 + kSixth * s3 + kTwelfth * s4;
-      Rq[a] += f * q[b];
-      if (b != a) Rq[b] += f * q[a];
-      e += (a == b ? 1.0 : 2.0) * h * q[a] * q[b];
-    }
+  const double e = stiffness ? assemble<true>(k2_, y3, y4, r, q, stiffness, Rq)
+                             : assemble<false>(k2_, y3, y4, r, q, nullptr, Rq);
   if (force)
     for (int i = 0; i < r; ++i) force[i] = Rq[i];
   if (energy) *energy = e;

@@ -72,6 +72,10 @@ public:
   void evaluateLanes(const double* const* q, int count, double* energy, double* const* force, double* stiffness,
                      double* scratch) const;
 
+  // Euler's weights (the header's formulas) as products: three divisions per pair had cost about
+  // a tenth of an evaluation.
+  static constexpr double kThird = 1.0 / 3, kSixth = 1.0 / 6, kTwelfth = 1.0 / 12;
+
   int r() const { return r_; }
   bool single() const { return q32_ != nullptr; }
   bool groups() const { return tripleOf_ != nullptr; }
@@ -93,10 +97,6 @@ private:
   static size_t measure(int r, bool single, bool monomials, bool groups);
   // The energy summed monomial by monomial (evaluate() asked for it alone).
   double energyFromMonomials(const double* q, double* scratch) const;
-
-  // Euler's weights (the header's formulas) as products: three divisions per pair had cost about
-  // a tenth of an evaluation.
-  static constexpr double kThird = 1.0 / 3, kSixth = 1.0 / 6, kTwelfth = 1.0 / 12;
 
   int r_ = 0;
   size_t pairs_ = 0;             // P = r(r+1)/2, for (a <= b) and for the products z_kl = q_k q_l
