@@ -36,6 +36,9 @@ int main(int argc, char** argv) {
   app.add_option("--min-dihedral", s.surface.mesher.minDihedral,
                  "A surface input: the smallest dihedral angle every tet must reach, degrees (checked)")
       ->check(app::Between(0.0, 60.0))->capture_default_str();
+  app.add_option("--mesher-time-limit", s.surface.mesher.timeLimit,
+                 "A surface input: seconds each gmsh run may take before the bake stops")
+      ->check(app::Positive)->capture_default_str();
   app.add_flag("--no-fill-holes{false}", s.surface.checks.fillHoles,
                "A surface input: refuse holes instead of closing each with a fan around its centre");
   app.add_option("--render-mesh", s.surface.renderMesh,
@@ -126,7 +129,7 @@ int main(int argc, char** argv) {
   ctx.quiet = quiet;
   ctx.progress(blas);
   if (isTetMeshPath(s.mesh.path) && ctx.rank() == 0)
-    for (const char* surfaceOnly : {"--tets", "--edge", "--min-dihedral", "--no-fill-holes"})
+    for (const char* surfaceOnly : {"--tets", "--edge", "--min-dihedral", "--mesher-time-limit", "--no-fill-holes"})
       if (app.count(surfaceOnly) > 0)
         std::cerr << "quiver-bake: warning: " << surfaceOnly << " applies to a surface input; " << s.mesh.path
                   << " is a tet mesh: ignored\n";

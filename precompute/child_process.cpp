@@ -2,6 +2,8 @@
 
 #include <atomic>
 #include <cerrno>
+#include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstring>
 #include <ctime>
@@ -72,7 +74,7 @@ void stop(pid_t pid) {
 
 Interrupted::Interrupted(int s) : std::runtime_error(std::string("interrupted by ") + strsignal(s)), signal(s) {}
 
-int runChild(const std::string& command) {
+int runChild(const std::string& command, double seconds) {
   const CaughtSignals signals;
   std::string shell = "sh", dashC = "-c", text = command;
   char* argv[] = {shell.data(), dashC.data(), text.data(), nullptr};
@@ -88,12 +90,17 @@ int runChild(const std::string& command) {
   posix_spawnattr_destroy(&attributes);
   if (error != 0) throw std::runtime_error(std::string("cannot start /bin/sh: ") + std::strerror(error));
   int status = 0;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(std::fmin(seconds, 1e9));
   // Polled, so that a signal between a check and a blocking wait cannot be missed: the runs take
   // seconds, the polls 10 ms.
   for (;; pause10ms()) {
     if (const int s = caught.load()) {
       stop(pid);
       throw Interrupted(s);
+    }
+    if (std::chrono::steady_clock::now() > deadline) {
+      stop(pid);
+      throw OutOfTime("the child ran past its time");
     }
     const pid_t done = waitpid(pid, &status, WNOHANG);
     if (done == pid) break;

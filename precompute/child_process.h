@@ -15,9 +15,15 @@ struct Interrupted : std::runtime_error {
   explicit Interrupted(int s);
 };
 
-// Runs `command` with /bin/sh -c and waits for it; returns its exit status (128 + the signal that
-// killed it). Throws Interrupted (above), or std::runtime_error when /bin/sh cannot start. Signals
-// the bake ignores (nohup's SIGHUP) stay ignored.
-int runChild(const std::string& command);
+// The child still ran when its time was up: it was terminated and waited for.
+struct OutOfTime : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Runs `command` with /bin/sh -c and waits for it, at most `seconds` (infinity: as long as it
+// runs); returns its exit status (128 + the signal that killed it). Throws Interrupted or OutOfTime
+// (above), or std::runtime_error when /bin/sh cannot start. Signals the bake ignores (nohup's
+// SIGHUP) stay ignored.
+int runChild(const std::string& command, double seconds);
 
 } // namespace quiver

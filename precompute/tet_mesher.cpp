@@ -103,6 +103,7 @@ MesherResult tetrahedralize(const CheckedSurface& surface, const MesherSettings&
   if (std::system(("command -v '" + s.program + "' > /dev/null 2>&1").c_str()) != 0)
     fail("needs the mesher '" + s.program + "' (Debian package gmsh, which scripts/quiver installs) to make tets of a surface");
   if (!(s.edgeLength > 0) && s.targetTets < 1) fail("--tets must be at least 1");
+  if (!(s.timeLimit > 0)) fail("--mesher-time-limit must be > 0 s");
   TempFolder folder;
   Eigen::Vector3d low = Eigen::Vector3d::Constant(INFINITY), high = -low;
   for (const auto& t : surface.triangles)
@@ -126,8 +127,17 @@ MesherResult tetrahedralize(const CheckedSurface& surface, const MesherSettings&
       const std::string command = "cd '" + folder.path.string() + "' && exec '" + s.program +
                                   "' surface.geo -3 -nt 1 -format msh22 -o tets.msh > gmsh.log 2>&1";
       ++result.runs;
+      int status = 0;
+      try {
+        status = runChild(command, s.timeLimit);
+      } catch (const OutOfTime&) {
+        char text[200];
+        std::snprintf(text, sizeof text, "gmsh ran past the time limit of %g s (--mesher-time-limit) at edge %.3g m; "
+                      "a larger --edge or fewer --tets, or a longer limit, helps", s.timeLimit, h * pass.scale);
+        fail(text);
+      }
       // A failed run may still write an empty .msh.
-      if (runChild(command) != 0 || !fs::exists(folder.path / "tets.msh") || fs::file_size(folder.path / "tets.msh") < 200)
+      if (status != 0 || !fs::exists(folder.path / "tets.msh") || fs::file_size(folder.path / "tets.msh") < 200)
         fail("gmsh could not make tets of the surface:" + lastLines(folder.path / "gmsh.log", 3));
       CheckedMesh checked = loadMesh((folder.path / "tets.msh").string());
       result.mesh = std::move(checked.mesh);

@@ -17,6 +17,7 @@ struct MesherSettings {
   int targetTets = 5000;        // about this many tets (used when edgeLength is 0)
   double edgeLength = 0;        // m; 0: from targetTets and the enclosed volume
   double minDihedral = 5;       // degrees: every tet at least this (checked on the result)
+  double timeLimit = 3600;      // s per gmsh run: a run past it stops the bake (a hung gmsh held it forever)
   std::string program = "gmsh";
 };
 
@@ -28,8 +29,8 @@ struct MesherResult {
   int runs = 0;
 };
 
-// Throws MeshError "NAME: ..." when Gmsh is missing, fails (with its last message) or cannot reach
-// the quality floor.
+// Throws MeshError "NAME: ..." when Gmsh is missing, fails (with its last message), runs past the
+// time limit or cannot reach the quality floor.
 MesherResult tetrahedralize(const CheckedSurface& surface, const MesherSettings& settings, const std::string& name);
 
 } // namespace quiver

@@ -152,7 +152,7 @@ class QuiverBake(unittest.TestCase):
         cases = [("--threads", "0", "a positive number"), ("--threads", "-2", "a positive number"),
                  ("--threads", "two", "a positive number"), ("--time-step", "inf", "a positive number"),
                  ("--damping-ratio", "inf", "a number >= 0"), ("--degenerate-tolerance", "nan", "a number from 0 to 1"),
-                 ("--min-dihedral", "nan", "a number from 0 to 60")]
+                 ("--min-dihedral", "nan", "a number from 0 to 60"), ("--mesher-time-limit", "0", "a positive number")]
         for option, value, expected in cases:
             with self.subTest(option=option, value=value):
                 p = subprocess.run([BAKE, self.beam, option, value, "-o", os.path.join(self.dir, "refused")],

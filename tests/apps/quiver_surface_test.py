@@ -319,6 +319,27 @@ class Surface(unittest.TestCase):
                 for pid in gmsh:
                     self.assertFalse(os.path.exists(f"/proc/{pid}"), f"gmsh ({pid}) still runs after {sig.name}")
 
+    def test_a_gmsh_run_past_the_time_limit_stops_the_bake(self):
+        # A hung gmsh held the bake forever. Here a run that would take far longer than its limit:
+        # it is stopped, its folder removed, and the bake fails saying so, before any output.
+        with tempfile.TemporaryDirectory() as tmp:
+            name = os.path.join(tmp, "out_of_time")
+            start = time.monotonic()
+            p = subprocess.run([BAKE, self.obj, "--tets", "400000", "--mesher-time-limit", "1", "--modes", "2", "--rank", "2",
+                                "--no-fidelity", "--quiet", "-o", name], env=dict(os.environ, TMPDIR=tmp),
+                               capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
+            elapsed = time.monotonic() - start
+            self.assertNotEqual(p.returncode, 0)
+            self.assertIn(f"{self.obj}: gmsh ran past the time limit of 1 s (--mesher-time-limit)", p.stderr)
+            self.assertLess(elapsed, 30)  # the limit, gmsh's two seconds to stop, and the bake's start
+            self.assertEqual(glob.glob(os.path.join(tmp, "quiver-mesher-*")), [])
+            self.assertEqual(sorted(os.listdir(tmp)), [])
+            for cwd in glob.glob("/proc/[0-9]*/cwd"):
+                try:
+                    self.assertFalse(os.readlink(cwd).startswith(tmp), f"{cwd} still runs in the bake's folder")
+                except OSError:
+                    continue
+
     def test_a_public_artist_mesh_bakes(self):
         if not os.path.exists(HUMAN):
             self.skipTest(f"Debian's assimp-testmodels is not installed ({HUMAN})")
