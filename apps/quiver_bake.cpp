@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
       ->check(app::NonNegative)
       ->capture_default_str();
   app.add_option("--time-step", s.output.model.timeStep, "Suggested time step stored in NAME.qvr, in s")
-      ->check(app::Positive)
+      ->check(app::TimeStep)
       ->capture_default_str();
   app.add_option("--fidelity-max-tets", s.fidelity.maxTets,
                  "Run the fidelity report only on meshes of at most this many tets (larger: skipped, saying so)")

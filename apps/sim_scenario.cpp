@@ -39,7 +39,7 @@ void SimOptions::addScenarioTo(CLI::App& app) {
   app.add_flag("--soft-contacts", step.softContacts,
                "Free flight: contacts hold the deformed surface, which gives way where they push (soft objects rest flat)");
   flight.addTo(app);
-  app.add_option("--dt", step.timeStep, "Time step, s")->check(Positive);
+  app.add_option("--dt", step.timeStep, "Time step, s")->check(TimeStep);
   app.add_option("--newton", step.newton,
                  "Newton iterations per implicit step: the most (--solver minimize, default 8; full space, default 20) "
                  "or exactly (--solver newton)")

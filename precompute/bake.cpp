@@ -9,6 +9,7 @@
 #include <petscsys.h>
 #include <slepcsys.h>
 
+#include "formats/model/qvr.h"
 #include "precompute/archive/xdmf.h"
 #include "precompute/rigid_modes.h"
 #include "precompute/stage_runner.h"
@@ -122,8 +123,8 @@ void checkBakeSettings(const BakeSettings& s) {
     throw std::invalid_argument("--basis-precision must be 32 or 64");
   if (!(s.output.model.dampingRatio >= 0 && std::isfinite(s.output.model.dampingRatio)))
     throw std::invalid_argument("--damping-ratio must be finite and >= 0");
-  if (!(s.output.model.timeStep > 0 && std::isfinite(s.output.model.timeStep)))
-    throw std::invalid_argument("--time-step must be finite and > 0 s");
+  if (!(s.output.model.timeStep >= kSmallestTimeStep && std::isfinite(s.output.model.timeStep)))
+    throw std::invalid_argument("--time-step must be finite and at least 1e-12 s");
   const fs::path folder = fs::path(s.output.name).parent_path();
   if (!folder.empty() && !fs::is_directory(folder))
     throw std::invalid_argument("output folder '" + folder.string() + "' does not exist");

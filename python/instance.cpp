@@ -91,7 +91,7 @@ qv_instance_config instanceConfig(const Model& model, const std::optional<std::s
   c.free_flight = freeFlight ? 1 : 0;
   c.max_contacts = maxContacts.value_or(c.max_contacts);
   c.soft_contacts = softContacts ? 1 : 0;
-  require(c.time_step > 0 && std::isfinite(c.time_step), "time_step must be positive and finite");
+  require(c.time_step >= QV_MIN_TIME_STEP && std::isfinite(c.time_step), "time_step must be finite and at least 1e-12 s");
   require(c.newton_iterations >= 1, "newton_iterations must be at least 1");
   require(c.newton_tolerance > 0 && std::isfinite(c.newton_tolerance), "newton_tolerance must be positive and finite");
   require(c.rayleigh_alpha >= 0 && std::isfinite(c.rayleigh_alpha), "rayleigh_alpha must be >= 0 and finite");

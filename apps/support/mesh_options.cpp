@@ -9,6 +9,7 @@
 #include "common/mesh_error.h"
 #include "formats/mesh/read_mesh.h"
 #include "formats/mesh/text_cursor.h"
+#include "formats/model/qvr.h"
 
 namespace quiver::app {
 
@@ -91,6 +92,8 @@ CLI::Validator numberWhere(std::function<bool(double)> holds, const std::string&
 const CLI::Validator Positive = numberWhere([](double x) { return x > 0 && std::isfinite(x); }, "a positive number", "POSITIVE");
 const CLI::Validator NonNegative =
     numberWhere([](double x) { return x >= 0 && std::isfinite(x); }, "a number >= 0", "NON-NEGATIVE");
+const CLI::Validator TimeStep = numberWhere([](double x) { return x >= kSmallestTimeStep && std::isfinite(x); },
+                                            "a time step of at least 1e-12 s", "SECONDS");
 const CLI::Validator Finite = numberWhere([](double x) { return std::isfinite(x); }, "a finite number", "FINITE");
 
 CLI::Validator Between(double low, double high) {

@@ -45,6 +45,8 @@ bool parseNumber(const std::string& text, double& value);
 // to 1.79e308" of a word, and prints that bound in full; these say what is expected.
 extern const CLI::Validator Positive;
 extern const CLI::Validator NonNegative;
+// A time step in s, at least kSmallestTimeStep (formats/model/qvr.h), finite.
+extern const CLI::Validator TimeStep;
 // Any finite number (a vector option checks each of its values).
 extern const CLI::Validator Finite;
 // A number from `low` to `high`: CLI::Range lets NaN through (no comparison with it fails).

@@ -448,7 +448,7 @@ int main(int argc, char** argv) {
   addIntegratorOption(app, o.settings.step.integrator);
   addElasticityOption(app, o.settings.step.elasticity);
   addSolverOption(app, o.settings.step.solver);
-  app.add_option("--dt", o.settings.step.timeStep, "Time step, s (default: the model's)")->check(Positive);
+  app.add_option("--dt", o.settings.step.timeStep, "Time step, s (default: the model's)")->check(TimeStep);
   app.add_option("--newton", o.settings.step.newton,
                  "Newton iterations per implicit step: the most (--solver minimize, default 8) or exactly (--solver newton)")
       ->check(CLI::Range(1, 20));

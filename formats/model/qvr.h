@@ -117,8 +117,13 @@ struct ModelInfo {
   double rayleighBeta = 0;                       // s, >= 0
   double bboxMin[3] = {0, 0, 0};                 // componentwise min of REST_POSITIONS, exactly
   double bboxMax[3] = {0, 0, 0};                 // componentwise max of REST_POSITIONS, exactly
-  double timeStep = 1.0 / 60.0;                  // suggested time step, s, > 0
+  double timeStep = 1.0 / 60.0;                  // suggested time step, s, >= kSmallestTimeStep
 };
+
+// The smallest time step a model suggests or an instance takes, s: far below any stable step of an
+// explicit integrator on a real model, and 1 / h^2, which the implicit ones scale by, stays far from
+// overflowing (at 1e-300 s it overflowed, and a state gone non-finite was blamed on the load).
+constexpr double kSmallestTimeStep = 1e-12;
 
 // MODEL_INFO's byte layout, the one place it is written down in code: calls visit(byteOffset, field)
 // for every field. `Info` is ModelInfo or const ModelInfo. Bytes 60-63 and 144-191 are reserved.

@@ -277,7 +277,7 @@ private:
                             {"totalMass", info.totalMass, 0, false, inf},
                             {"rayleighAlpha", info.rayleighAlpha, 0, true, inf},
                             {"rayleighBeta", info.rayleighBeta, 0, true, inf},
-                            {"timeStep", info.timeStep, 0, false, inf}};
+                            {"timeStep", info.timeStep, kSmallestTimeStep, true, inf}};
     for (const Range& f : ranges)
       if (!finite(f.value) || !(f.lowIncluded ? f.value >= f.low : f.value > f.low) || !(f.value < f.high))
         return bad(std::string(f.name) + " " + number(f.value) + " is not finite and in " + (f.lowIncluded ? "[" : "(") +

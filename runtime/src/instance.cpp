@@ -10,9 +10,12 @@
 #include "dense_solve.h"
 #include "dynamics.h"
 #include "elasticity.h"
+#include "formats/model/qvr.h"
 #include "integrators/integrator.h"
 
 namespace quiver::rt {
+
+static_assert(QV_MIN_TIME_STEP == quiver::kSmallestTimeStep, "a model's suggested step is one an instance takes");
 
 bool validConfig(const qv_model* model, const qv_instance_config* c) {
   if (!model || !c) return false;
@@ -20,7 +23,7 @@ bool validConfig(const qv_model* model, const qv_instance_config* c) {
   return integrator >= 0 && integrator < QV_INTEGRATOR_COUNT && solver >= 0 && solver < QV_SOLVER_COUNT &&
          c->newton_tolerance > 0 && std::isfinite(c->newton_tolerance) && elasticity >= 0 &&
          elasticity < QV_ELASTICITY_COUNT && (!kElasticities[elasticity].needsRotations || model->rotations) &&
-         c->time_step > 0 && std::isfinite(c->time_step) && c->newton_iterations >= 1 && c->rayleigh_alpha >= 0 &&
+         c->time_step >= QV_MIN_TIME_STEP && std::isfinite(c->time_step) && c->newton_iterations >= 1 && c->rayleigh_alpha >= 0 &&
          c->rayleigh_beta >= 0 && c->max_constraints >= 0 && c->max_constraints <= 64 && c->max_displacement > 0 &&
          (c->free_flight == 0 || (c->free_flight == 1 && model->rigidBody)) && c->max_contacts >= 0 &&
          c->max_contacts <= 4096 && (c->soft_contacts == 0 || (c->soft_contacts == 1 && c->free_flight == 1 &&

@@ -150,7 +150,8 @@ class QuiverBake(unittest.TestCase):
     def test_options_out_of_range_are_refused_by_the_command_line(self):
         # Before any work: --time-step inf was once refused only by the export, after every stage.
         cases = [("--threads", "0", "a positive number"), ("--threads", "-2", "a positive number"),
-                 ("--threads", "two", "a positive number"), ("--time-step", "inf", "a positive number"),
+                 ("--threads", "two", "a positive number"), ("--time-step", "inf", "a time step of at least 1e-12 s"),
+                 ("--time-step", "1e-300", "a time step of at least 1e-12 s"),
                  ("--damping-ratio", "inf", "a number >= 0"), ("--degenerate-tolerance", "nan", "a number from 0 to 1"),
                  ("--min-dihedral", "nan", "a number from 0 to 60"), ("--mesher-time-limit", "0", "a positive number")]
         for option, value, expected in cases:

@@ -206,6 +206,8 @@ class QuiverSim(OnTheBakedModel):
     def test_bad_options(self):
         for args, message in ((["--group", "x<-5"], "selects no vertex"), (["--group", "q<1"], "--group"),
                               (["--dt", "-1"], "--dt"), (["--newton", "0"], "--newton"), (["--solver", "gauss"], "gauss"),
+                              # 1 / h^2 overflowed, and the state gone non-finite was blamed on the load.
+                              (["--dt", "1e-300"], "--dt: expected a time step of at least 1e-12 s"),
                               # Once taken: a NaN load reset the model every step, a spring of no stiffness
                               # did nothing, and a negative damping meant the model's.
                               (["--force", "nan,0,0"], "--force: expected a finite number, not 'nan'"),

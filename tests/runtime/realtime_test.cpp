@@ -143,6 +143,8 @@ TEST(RealTime, BadArgumentsAreRefusedNotCrashed) {
   qv_instance_config bad = config;
   bad.time_step = -1;
   EXPECT_EQ(qv_instance_create(m.model, &bad, nullptr, &s), QV_ERROR_INVALID_ARGUMENT);
+  bad.time_step = 1e-300;  // 1 / h^2 overflows: refused, not left to go non-finite
+  EXPECT_EQ(qv_instance_create(m.model, &bad, nullptr, &s), QV_ERROR_INVALID_ARGUMENT);
   bad = config;
   bad.newton_iterations = 0;
   EXPECT_EQ(qv_instance_create(m.model, &bad, nullptr, &s), QV_ERROR_INVALID_ARGUMENT);

@@ -31,6 +31,10 @@ QV_API int qv_check_version(int version_number, size_t model_info_size, size_t i
 /* Standard gravity, m/s^2: what the tools, the bake's fidelity report and the examples mean by "gravity". */
 #define QV_STANDARD_GRAVITY 9.81
 
+/* The smallest time step an instance takes (qv_instance_config.time_step), s: 1 / h^2, by which the
+   implicit integrators scale, stays far from overflowing. */
+#define QV_MIN_TIME_STEP 1e-12
+
 typedef enum qv_result {
   QV_OK = 0,
   QV_ERROR_INVALID_ARGUMENT = 1, /* a null pointer or a size that does not fit */
@@ -198,7 +202,7 @@ QV_API qv_result qv_solver_from_name(const char* name, qv_solver* solver);
 
 typedef struct qv_instance_config {
   qv_integrator integrator;  /* default QV_INTEGRATOR_IMPLICIT_NEWMARK */
-  double time_step;          /* s, > 0; default: the model's suggested step */
+  double time_step;          /* s, >= QV_MIN_TIME_STEP; default: the model's suggested step */
   qv_solver solver;          /* implicit integrators; default QV_SOLVER_MINIMIZE */
   int newton_iterations;     /* >= 1: the most Newton iterations (QV_SOLVER_MINIMIZE, default 8), or exactly this many
                                 (QV_SOLVER_NEWTON; Barbic & James use 1; a step the minimiser takes over: at most 8) */

@@ -210,6 +210,7 @@ TEST(QvrValidation, ModelInfoAndArraysAreChecked) {
       {[](ModelContents& c) { c.info.rayleighAlpha = -1e-300; }, "rayleighAlpha -1e-300 is not finite and in [0, inf)"},
       {[](ModelContents& c) { c.info.rayleighBeta = kNaN; }, "rayleighBeta nan"},
       {[](ModelContents& c) { c.info.timeStep = 0; }, "timeStep 0 is"},
+      {[](ModelContents& c) { c.info.timeStep = 1e-300; }, "timeStep 1e-300 is not finite and in [1e-12, inf)"},
       {[](ModelContents& c) { c.info.bboxMax[1] += 1; }, "MODEL_INFO at byte 384: bounding box along axis 1"},
       {[](ModelContents& c) { c.info.bboxMin[2] -= 10; }, "bounding box along axis 2"},
       {[](ModelContents& c) { c.energy.pop_back(); },
