@@ -17,7 +17,7 @@ extern "C" {
 
 #define QV_VERSION_MAJOR 0
 #define QV_VERSION_MINOR 12
-#define QV_VERSION_PATCH 6
+#define QV_VERSION_PATCH 7
 #define QV_VERSION_NUMBER (QV_VERSION_MAJOR * 10000 + QV_VERSION_MINOR * 100 + QV_VERSION_PATCH)
 
 /* The library's version as "major.minor.patch". */
