@@ -187,10 +187,9 @@ QV_HOT double monomialEnergy(const double* c, int r, const double* q, const doub
 template <bool withK>
 QV_HOT double assemble(const double* __restrict k2, const double* __restrict y3, const double* __restrict y4, int r,
                        const double* __restrict q, double* __restrict K, double* __restrict R) {
-  using P = ReducedPolynomial;
   const auto stiffnessAt = [&](size_t p) { return k2[p] + y3[p] + y4[p]; };
-  const auto forceWeight = [&](size_t p) { return k2[p] + 0.5 * y3[p] + P::kThird * y4[p]; };
-  const auto energyWeight = [&](size_t p) { return 0.5 * k2[p] + P::kSixth * y3[p] + P::kTwelfth * y4[p]; };
+  const auto forceWeight = [&](size_t p) { return ReducedPolynomial::forceWeight(k2[p], y3[p], y4[p]); };
+  const auto energyWeight = [&](size_t p) { return ReducedPolynomial::energyWeight(k2[p], y3[p], y4[p]); };
   for (int i = 0; i < r; ++i) R[i] = 0;
   double e = 0;
   for (int a = 0; a < r; ++a) {

@@ -72,9 +72,10 @@ public:
   void evaluateLanes(const double* const* q, int count, double* energy, double* const* force, double* stiffness,
                      double* scratch) const;
 
-  // Euler's weights (the header's formulas) as products: three divisions per pair had cost about
-  // a tenth of an evaluation.
-  static constexpr double kThird = 1.0 / 3, kSixth = 1.0 / 6, kTwelfth = 1.0 / 12;
+  // Euler's weights for one pair from its parts k2, K_3 and K_4 (the header's formulas): R(q) sums
+  // forceWeight q_b per row, E(q) is q^T energyWeight q. evaluate() and evaluateLanes() both use them.
+  static double forceWeight(double k2, double k3, double k4) { return k2 + 0.5 * k3 + kThird * k4; }
+  static double energyWeight(double k2, double k3, double k4) { return 0.5 * k2 + kSixth * k3 + kTwelfth * k4; }
 
   int r() const { return r_; }
   bool single() const { return q32_ != nullptr; }
@@ -97,6 +98,10 @@ private:
   static size_t measure(int r, bool single, bool monomials, bool groups);
   // The energy summed monomial by monomial (evaluate() asked for it alone).
   double energyFromMonomials(const double* q, double* scratch) const;
+
+  // Euler's weights (the header's formulas) as products: three divisions per pair had cost about
+  // a tenth of an evaluation.
+  static constexpr double kThird = 1.0 / 3, kSixth = 1.0 / 6, kTwelfth = 1.0 / 12;
 
   int r_ = 0;
   size_t pairs_ = 0;             // P = r(r+1)/2, for (a <= b) and for the products z_kl = q_k q_l

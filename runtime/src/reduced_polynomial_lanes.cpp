@@ -154,7 +154,7 @@ QV_HOT void ReducedPolynomial::evaluateLanes(const double* const* q, int count, 
       for (int l = 0; l < L; ++l) {
         const double s3 = y3[p * L + l], s4 = y4[p * L + l];
         stiffness[p * L + l] = k2 + s3 + s4;
-        const double f = k2 + 0.5 * s3 + kThird * s4, h = 0.5 * k2 + kSixth * s3 + kTwelfth * s4;
+        const double f = forceWeight(k2, s3, s4), h = energyWeight(k2, s3, s4);
         const double qa = ql[a * L + l], qb = ql[b * L + l];
         Rq[a * L + l] += f * qb;
         if (b != a) Rq[b * L + l] += f * qa;
