@@ -1,6 +1,6 @@
 // The runtime's hot paths on baked models, single thread (Google Benchmark):
 //   Evaluate/force, Evaluate/force+stiffness (float64 and float32 coefficients), EvaluateGroup
-//   (eight states at once, as qv_instances_step evaluates them; both precisions), Step/newton
+//   (sixteen states at once, as qv_instances_step evaluates them; both precisions), Step/newton
 //   (implicit Newmark, Barbic & James's one Newton iteration; both precisions), Step/minimize (the
 //   default solver), both under a load that keeps the object moving, and ManyObjects: 1000
 //   instances of one model stepped per frame (both solvers, one by one and in one
@@ -170,6 +170,7 @@ void EvaluateGroup(benchmark::State& state, const char* path, int precision) {
     q[0] += 1e-12;
   }
   state.counters["r"] = r;
+  state.counters["states"] = L;
   state.counters["GFLOPS"] =
       benchmark::Counter(groupFlops(r) * state.iterations(), benchmark::Counter::kIsRate, benchmark::Counter::kIs1000);
   std::free(scratch);
@@ -215,7 +216,7 @@ void Step(benchmark::State& state, const char* path, qv_solver solver, int preci
 // `objects` instances of one model per frame, each under its own push on the first coordinate (0.1
 // to 0.2 times what gravity puts there, flipping every quarter second, out of phase from one
 // instance to the next: the load of Step, spread), stepped one by one (qv_instance_step) or in one call
-// (qv_instances_step: groups of 8 evaluated together).
+// (qv_instances_step: groups of 16 evaluated together).
 void ManyObjects(benchmark::State& state, const char* path, qv_solver solver, bool together) {
   Loaded m(path);
   const int objects = static_cast<int>(state.range(0)), r = m.info.r;

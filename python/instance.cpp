@@ -225,8 +225,8 @@ py::list stepMany(py::handle sequence, int threads) {
     if (s->world) throw py::value_error("step_many: item " + std::to_string(i) + " is in a World, which steps it");
   }
   const int count = static_cast<int>(instances.size());
-  // Jobs are cut on groups of 8: more jobs than groups would only idle (and change no bit).
-  const int jobCount = std::min(threads, (count + 7) / 8);
+  // Jobs are cut on whole groups: more jobs than groups would only idle (and change no bit).
+  const int jobCount = std::min(threads, (count + QV_GROUP_SIZE - 1) / QV_GROUP_SIZE);
   const qv_model* model = instances[0]->model->get();
   const size_t bytes = qv_instances_step_scratch_size(model, jobCount);
   const AlignedBuffer scratch(bytes);

@@ -35,22 +35,22 @@ struct LaneFactor {
   static void load(const double* at, double& value) { value = *at; }
 };
 
-// Four lanes of choleskyFactorLanes()'s factors at once (lanes 4 half to 4 half + 3), as
+// Four lanes of choleskyFactorLanes()'s factors at once (lanes 4 part to 4 part + 3), as
 // choleskySubstitute() reads them: an entry is the vector of those lanes', and so is each
 // right-hand side's entry (four lanes interleaved), so that the group's systems are solved four at
-// a time, each lane by its own solve's operations. Four, not all eight: where vectors are four
-// doubles wide, GCC moved eight-wide ones through the stack.
+// a time, each lane by its own solve's operations. Four, not more: where vectors are four doubles
+// wide, GCC moved eight-wide ones through the stack.
 struct LanesFactor {
   static constexpr int kStride = kCholeskyLanes, kWidth = 4;
   typedef double Value __attribute__((vector_size(kWidth * sizeof(double))));
   const double* A;
-  int n, half;
+  int n, part;
   const double* row(int i) const {
-    return A + (packedUpperIndex(n, i, i) - static_cast<size_t>(i)) * kStride + kWidth * half;
+    return A + (packedUpperIndex(n, i, i) - static_cast<size_t>(i)) * kStride + kWidth * part;
   }
   // By reference: a returned vector's ABI depends on the instruction set it is compiled for.
   static void load(const double* at, Value& value) { std::memcpy(&value, at, sizeof value); }
 };
-static_assert(kCholeskyLanes == 2 * LanesFactor::kWidth, "a group's lanes are two LanesFactor halves");
+static_assert(kCholeskyLanes % LanesFactor::kWidth == 0, "a group's lanes are whole LanesFactor parts");
 
 } // namespace quiver::rt

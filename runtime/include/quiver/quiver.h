@@ -16,8 +16,8 @@ extern "C" {
 #endif
 
 #define QV_VERSION_MAJOR 0
-#define QV_VERSION_MINOR 12
-#define QV_VERSION_PATCH 7
+#define QV_VERSION_MINOR 13
+#define QV_VERSION_PATCH 0
 #define QV_VERSION_NUMBER (QV_VERSION_MAJOR * 10000 + QV_VERSION_MINOR * 100 + QV_VERSION_PATCH)
 
 /* The library's version as "major.minor.patch". */
@@ -273,13 +273,14 @@ typedef struct qv_step_report {
 QV_API void qv_instance_last_step(const qv_instance* instance, qv_step_report* report);
 
 /* Many instances of one model in one call: each is stepped as qv_instance_step() would step it,
-   but implicit Newmark St.Venant-Kirchhoff instances are evaluated 8 at a time: each coefficient
-   is read once for the 8 and multiplies their states at once (SIMD across instances), and their
-   Newton matrices are factorised 8 at a time (not in free flight, where they depend on the state),
+   but implicit Newmark St.Venant-Kirchhoff instances are evaluated QV_GROUP_SIZE (16) at a time:
+   each coefficient is read once for the 16 and multiplies their states at once (SIMD across
+   instances), and their Newton matrices are factorised 16 at a time (not in free flight, where
+   they depend on the state),
    on models loaded with the groups' layout (qv_model_config.group_layout; without it each
    instance steps as alone).
-   QV_SOLVER_NEWTON steps go in groups of 8 (the evaluation and matrix at the state: the whole of
-   a one-iteration step but its substitution); QV_SOLVER_MINIMIZE steps run up to 8 in lock step,
+   QV_SOLVER_NEWTON steps go in groups of 16 (the evaluation and matrix at the state: the whole of
+   a one-iteration step but its substitution); QV_SOLVER_MINIMIZE steps run up to 16 in lock step,
    sharing every evaluation of their iterations and line searches (the energy budget's rare
    draw-back evaluates alone). The sums run in another
    order than one instance's, so states agree with qv_instance_step() to rounding, not bit for bit
@@ -290,10 +291,11 @@ QV_API void qv_instance_last_step(const qv_instance* instance, qv_step_report* r
 
    No allocation: `scratch` (64-byte aligned) holds qv_instances_step_scratch_size(model, jobs)
    bytes. No threads: with `jobs` not NULL the instances are cut into jobs->count contiguous ranges
-   (on multiples of 8), and jobs->run(jobs->user, job, job_data, jobs->count) must call
+   (on multiples of QV_GROUP_SIZE: more jobs than groups only idle), and jobs->run(jobs->user, job, job_data, jobs->count) must call
    job(job_data, i) once for each i, on any threads, and return when all have run. NULL: one job on the calling thread. The same
    instance may not appear twice. statuses[i] (when not NULL) receives instances[i]'s status.
    QV_ERROR_INVALID_ARGUMENT: a null pointer, instances of different models, too small a scratch. */
+#define QV_GROUP_SIZE 16
 typedef void (*qv_job_function)(void* job_data, int job_index);
 typedef struct qv_job_runner {
   int count; /* >= 1: how many jobs (e.g. worker threads) */
