@@ -11,9 +11,10 @@ namespace quiver::rt {
 void fillSystem(qv_instance& s, const double* stateJacobian, const SystemScales& scales) {
   const int r = s.r;
   const double* D = s.dampingStiffness;
+  const double* K = wholeStiffness(s);
   for (int i = 0; i < r; ++i)
     for (int j = i; j < r; ++j)
-      s.work.system[i * r + j] = scales.stiffness * s.work.stiffness[i * r + j] +
+      s.work.system[i * r + j] = scales.stiffness * K[i * r + j] +
                                  scales.stateJacobian * stateJacobian[i * r + j] +
                                  scales.dampingStiffness * D[i * r + j] + (i == j ? scales.identity : 0.0);
 }
@@ -59,6 +60,42 @@ QV_HOT void dampingForces(const qv_instance& s, const double* K, const double* v
   }
 }
 
+// Along the packed rows: the terms below the diagonal as axpys, the others as row a's dot product,
+// in four sums (one vectorised reduction per short row spilled its vector to sum it).
+QV_HOT void dampingForces(const qv_instance& s, const double* v, double* out) {
+  const double* K = s.work.stiffnessPacked;
+  if (!K) return dampingForces(s, s.work.stiffness, v, out);
+  const int r = s.r;
+  const double alpha = s.config.rayleigh_alpha, beta = s.config.rayleigh_beta;
+  for (int i = 0; i < r; ++i) out[i] = 0;
+  for (int a = 0; a < r; ++a) {
+    const double* row = K + packedUpperIndex(r, a, a) - a;  // row[b] = K_ab, b >= a
+    const double va = v[a];
+#pragma omp simd
+    for (int b = a + 1; b < r; ++b) out[b] += row[b] * va;
+    double sum[4] = {row[a] * va, 0, 0, 0};
+    int b = a + 1;
+    for (; b + 4 <= r; b += 4)
+      for (int u = 0; u < 4; ++u) sum[u] += row[b + u] * v[b + u];
+    for (; b < r; ++b) sum[0] += row[b] * v[b];
+    out[a] += (sum[0] + sum[1]) + (sum[2] + sum[3]);
+  }
+  for (int i = 0; i < r; ++i) out[i] = alpha * v[i] + beta * out[i];
+}
+
+const double* wholeStiffness(qv_instance& s) {
+  if (const double* K = s.work.stiffnessPacked) {
+    const int r = s.r;
+    for (int a = 0; a < r; ++a) {
+      double* row = s.work.stiffness + a * r;
+      for (int b = 0; b < a; ++b) row[b] = s.work.stiffness[b * r + a];  // written with row b
+      for (int b = a; b < r; ++b) row[b] = K[packedUpperIndex(r, a, b)];
+    }
+  }
+  s.work.stiffnessPacked = nullptr;
+  return s.work.stiffness;
+}
+
 LaneFactor takePresetFactor(qv_instance& s, const SystemScales& scales) {
   const LaneFactor factor = scales == s.work.presetScales ? s.work.presetFactor : LaneFactor{};
   s.work.presetFactor = LaneFactor{};
@@ -70,6 +107,7 @@ bool elasticityAt(qv_instance& s, const double* q, double* energy, double* force
   const bool preset = s.work.presetValid && std::memcmp(q, s.work.presetAt, sizeof(double) * s.r) == 0;
   s.work.presetValid = false;  // only ever the next evaluation: the one after is elsewhere
   if (!preset) s.work.presetFactor = LaneFactor{};
+  s.work.stiffnessPacked = preset ? s.work.presetStiffness : nullptr;
   if (preset) {
     std::memcpy(force, s.work.presetForce, sizeof(double) * s.r);
     if (energy) *energy = s.work.presetEnergy;

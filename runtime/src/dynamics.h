@@ -10,9 +10,14 @@
 namespace quiver::rt {
 
 // E(q) (when `energy` is not null), R(q) into `force` and K(q) into s.work.stiffness: the
-// group's preset when it was evaluated at exactly q (step_many.h), else evaluated now. Returns
-// whether K(q) is known to be positive definite (the group's presetDefinite).
+// group's preset when it was evaluated at exactly q (step_many.h; K left in the group's scratch,
+// s.work.stiffnessPacked), else evaluated now. Returns whether K(q) is known to be positive definite
+// (the group's presetDefinite).
 bool elasticityAt(qv_instance& s, const double* q, double* energy, double* force);
+
+// K(q) last evaluated, as a whole r x r matrix: s.work.stiffness, copied there from the group's
+// lanes first if it is still in them.
+const double* wholeStiffness(qv_instance& s);
 
 // Fills s.work.force = R(q) + S(q) and s.work.stiffness = K(q); returns J.
 const double* evaluateForces(qv_instance& s, const double* q);
@@ -22,9 +27,8 @@ const double* evaluateForces(qv_instance& s, const double* q);
 // rows as axpys (SIMD across i), each sum over j in order, instead of r chains of r dependent
 // multiply-adds.
 void dampingForces(const qv_instance& s, const double* K, const double* v, double* out);
-inline void dampingForces(const qv_instance& s, const double* v, double* out) {
-  dampingForces(s, s.work.stiffness, v, out);
-}
+// The same with K(q) last evaluated, read from the group's lanes when it is still in them.
+void dampingForces(const qv_instance& s, const double* v, double* out);
 
 // The fixed Newton step's (I + c1 C + c2 (K + J)), C = alpha I + beta K(q). Fused explicitly: the
 // group and the solver compute it in code built for different instruction sets, and a group's

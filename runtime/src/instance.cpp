@@ -112,20 +112,18 @@ qv_instance* constructInstance(const qv_model& model, const qv_instance_config& 
 
 } // namespace quiver::rt
 
+// The vectors every step touches first, together (a crowd's members' blocks are cold at each
+// step: contiguous, the prefetcher streams them), then the matrices.
 void qv_instance::carve(quiver::rt::BlockCarver& c) {
   const size_t rr = static_cast<size_t>(r) * r;
   q = c.take<double>(r);
   v = c.take<double>(r);
   a = c.take<double>(r);
-  dampingStiffness = c.take<double>(rr);
   previousQ = c.take<double>(r);
-  loads.carve(c, r, config.max_constraints, flying());
   end.q = c.take<double>(r);
   end.v = c.take<double>(r);
   end.a = c.take<double>(r);
   work.force = c.take<double>(r);
-  work.stiffness = c.take<double>(rr);
-  work.system = c.take<double>(rr);
   work.correction = c.take<double>(r);
   work.damping = c.take<double>(r);
   work.predictor = c.take<double>(r);
@@ -135,9 +133,13 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
   work.segmentEnd = c.take<double>(r);
   work.midpointVelocity = c.take<double>(r);
   work.stateForceSink = c.take<double>(r);
-  work.polynomialScratch = c.take<double>(quiver::rt::ReducedPolynomial::scratchSize(r));
   work.presetAt = c.take<double>(r);
   work.presetForce = c.take<double>(r);
+  loads.carve(c, r, config.max_constraints, flying());
+  dampingStiffness = c.take<double>(rr);
+  work.stiffness = c.take<double>(rr);
+  work.system = c.take<double>(rr);
+  work.polynomialScratch = c.take<double>(quiver::rt::ReducedPolynomial::scratchSize(r));
   if (flying()) {
     frame.attach(c.take<double>(quiver::rt::RigidFrame::scratchDoubles(r)), r);
     startQ = c.take<double>(r);
@@ -280,6 +282,7 @@ void qv_instance::moveFrame() {
 qv_step_status qv_instance::endStep(qv_step_status status) {
   work.presetValid = false;
   work.presetFactor = quiver::rt::LaneFactor{};
+  work.stiffnessPacked = nullptr;  // the group's lanes are overwritten after its step; no step reads K before evaluating it
   loads.endStep();
   if (status == QV_STEP_RESET || !healthy()) {
     rest();
@@ -307,14 +310,17 @@ void qv_instance::setState(const double* newQ, const double* newV, const double*
   const bool newAccount = keepsEnergyAccount() && (newQ || newV);
   if (newQ || newAccount)
     elasticEnergyAtState = quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
-  if (newQ) quiver::rt::dampWithStiffness(*this, work.stiffness, dampingStiffness);
+  if (newQ) quiver::rt::dampWithStiffness(*this, quiver::rt::wholeStiffness(*this), dampingStiffness);
   if (newA) {
     std::memcpy(a, newA, sizeof(double) * r);
   } else if (consistentA) {
     // The acceleration the equations of motion give at the new state (persistent loads only), so
     // that the next implicit step starts consistent rather than injecting energy; damped as the
     // solver damps.
-    quiver::rt::dampingForces(*this, minimizes() ? dampingStiffness : work.stiffness, v, work.damping);
+    if (minimizes())
+      quiver::rt::dampingForces(*this, dampingStiffness, v, work.damping);
+    else
+      quiver::rt::dampingForces(*this, v, work.damping);
     for (int i = 0; i < r; ++i) a[i] = loads.gravityForce[i] - work.force[i] - work.damping[i];
   }
   energySlack = 0;

@@ -31,7 +31,12 @@ struct SystemScales {
 // What one evaluation at a trial state fills, and the Newton system built from it.
 struct StepBuffers {
   double* force = nullptr;        // R(q) plus the state forces (resisting: the step subtracts it)
-  double* stiffness = nullptr;    // K(q), elastic only (Rayleigh damping uses it)
+  double* stiffness = nullptr;    // K(q), elastic only (Rayleigh damping uses it), unless in stiffnessPacked
+  // K(q) where a group evaluated it: its upper triangle packed row by row in the group's scratch
+  // (step_many.h), not copied here until a reader needs the whole matrix (wholeStiffness(),
+  // dynamics.h). The damping products read it there: the whole matrix written into every member
+  // had cost more than both products of a fixed Newton step.
+  const double* stiffnessPacked = nullptr;
   double* system = nullptr;       // the Newton matrix, factorised in place
   double* correction = nullptr;   // the Newton right-hand side in, the correction out
   double* damping = nullptr;      // C v (dampingForces(), dynamics.h)
@@ -44,10 +49,11 @@ struct StepBuffers {
   double* stateForceSink = nullptr;    // where stepEnergy() lets the state forces add the force it does not need
   double* polynomialScratch = nullptr;
   // A group stepped together (step_many.h) evaluates each member's polynomial at the point its
-  // step will evaluate next: R(q) and E(q) here, K(q) in `stiffness`. The step's next elastic
+  // step will evaluate next: R(q) and E(q) here, K(q) in the group's lanes. The step's next elastic
   // evaluation takes them when it is at exactly that point (elasticityAt(), dynamics.h).
   double* presetAt = nullptr;
   double* presetForce = nullptr;
+  const double* presetStiffness = nullptr;  // packed, as stiffnessPacked
   double presetEnergy = 0;
   bool presetValid = false;
   // Whether the group found that K(q) positive definite, as choleskyFactor() judges (a minimising
@@ -137,6 +143,7 @@ struct qv_instance {
   void setState(const double* q, const double* v, const double* a);
   // D from K(q) into `D` (r x r; may be work.stiffness), as a minimising step that ended at q would
   // leave it: for a state set from outside (setState(), a fixed Newton step the minimiser takes over).
+  // K(q) is evaluated into work.stiffness: no group's K may be pending in work.stiffnessPacked.
   void dampingStiffnessAtState(double* D) const;
   bool flying() const { return config.free_flight != 0; }
   // How fast the step would move the contact modes under its loads so far, contact forces not yet

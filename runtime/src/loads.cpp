@@ -10,12 +10,12 @@ void Loads::carve(BlockCarver& c, int reducedSize, int slotCount, bool flying) {
   r = reducedSize;
   slots = slotCount;
   const size_t rr = static_cast<size_t>(r) * r;
-  stepForce = c.take<double>(r);
+  stepForce = c.take<double>(r);  // the vectors first (qv_instance::carve())
   lastStepForce = c.take<double>(r);
   gravityForce = c.take<double>(r);
   frameForce = c.take<double>(r);
-  constraintK = c.take<double>(rr);
   constraintB = c.take<double>(r);
+  constraintK = c.take<double>(rr);
   slotK = c.take<double>(rr * slots);
   slotB = c.take<double>(static_cast<size_t>(r) * slots);
   slotActive = c.take<int>(slots);

@@ -18,9 +18,13 @@ static_assert(kLanes == QV_GROUP_SIZE, "quiver.h tells callers the group size");
 
 size_t pairs(int r) { return static_cast<size_t>(r) * (r + 1) / 2; }
 
-// A job's scratch (stepManyScratchPerJob()) holds the group's K packed by lane, then what the
-// evaluation uses, which is free again once it has run: where that second part begins.
-double* afterStiffness(double* scratch, int r) { return scratch + pairs(r) * kLanes; }
+// A job's scratch (stepManyScratchPerJob()): the group's K packed by lane (evaluateLanes()); the
+// same, each member's packed on its own, which members read until their steps end
+// (qv_instance::work.stiffnessPacked); the group's factors (its systems from K, factorised); then
+// what the evaluation uses, free again once it has run.
+double* memberStiffness(double* scratch, int r) { return scratch + pairs(r) * kLanes; }
+double* factorLanes(double* scratch, int r) { return scratch + 2 * pairs(r) * kLanes; }
+double* afterFactors(double* scratch, int r) { return scratch + 3 * pairs(r) * kLanes; }
 
 // Whose step begins with a polynomial evaluation (implicit Newmark's: the minimiser's at
 // newmarkGuess(), the fixed Newton step's at q), on a model laid out for groups
@@ -34,27 +38,12 @@ bool groupable(const qv_instance& s) {
 // the state forces' Jacobian depends on q (elsewhere it is the constraints' constant one).
 bool factorisedInGroup(const qv_instance& s) { return !s.flying(); }
 
-// Copies the group's symmetric matrices, packed by lane (evaluateLanes()'s layout), into the
-// members' whole row-major r x r matrices, each output row written in order: its lower part from
-// the member's own column above the diagonal, already written (read from the lanes, every entry
-// cost an index computation and a load from its own line: a third more time), its upper part from
-// the packed row (one short contiguous run of lanes per entry).
-QV_HOT void unpackSymmetric(const double* lanes, int r, int count, double* const* out) {
-  for (int a = 0; a < r; ++a) {
-    const double* row = lanes + (packedUpperIndex(r, a, a) - static_cast<size_t>(a)) * kLanes;
-    for (int l = 0; l < count; ++l) {
-      double* K = out[l] + a * r;
-      for (int b = 0; b < a; ++b) K[b] = out[l][b * r + a];
-      for (int b = a; b < r; ++b) K[b] = row[b * kLanes + l];
-    }
-  }
-}
-
 // Factorises together the members' matrices with `scales` (SystemScales, instance.h) at the
-// point just evaluated, `A` holding the group's K (as evaluateLanes() leaves it), in place, and
-// hands each member its lane of A (presetFactor). Lanes not factorised (factorisedInGroup())
-// factorise the identity.
-QV_HOT void factoriseGroup(qv_instance* const* group, int count, const SystemScales* scales, double* A) {
+// point just evaluated, from `K`, the group's K (as evaluateLanes() leaves it), into `A`, and hands
+// each member its lane of A (presetFactor). Lanes not factorised (factorisedInGroup()) factorise
+// the identity.
+QV_HOT void factoriseGroup(qv_instance* const* group, int count, const SystemScales* scales, const double* K,
+                           double* A) {
   const int r = group[0]->r;
   SystemScales lane[kLanes];
   const double* J[kLanes];
@@ -76,7 +65,7 @@ QV_HOT void factoriseGroup(qv_instance* const* group, int count, const SystemSca
   for (int a = 0, p = 0; a < r; ++a)
     for (int b = a; b < r; ++b, ++p) {
       double* x = A + p * kLanes;
-      for (int l = 0; l < kLanes; ++l) x[l] *= lane[l].stiffness;
+      for (int l = 0; l < kLanes; ++l) x[l] = K[p * kLanes + l] * lane[l].stiffness;
       if (constrained)
         for (int l = 0; l < kLanes; ++l) x[l] += lane[l].stateJacobian * J[l][a * r + b];
       if (damped)
@@ -95,23 +84,26 @@ QV_HOT void factoriseGroup(qv_instance* const* group, int count, const SystemSca
 }
 
 // Evaluates the members' polynomials together at their presetAt points and leaves each one's
-// preset for its step's next evaluation there: R(q) and E(q), K(q) in its `stiffness`; returns
-// the group's K packed by lane (evaluateLanes()) in `scratch`.
+// preset for its step's next evaluation there: R(q), E(q) and K(q) (packed, in the scratch);
+// returns the group's K packed by lane (evaluateLanes()) at the start of `scratch`.
 QV_HOT double* evaluateTogether(qv_instance* const* members, int count, double* scratch) {
   const int r = members[0]->r;
   double* stiffnessLanes = scratch;  // [pair][lane]
   const double* at[kLanes] = {};
   double* force[kLanes] = {};
-  double* stiffness[kLanes] = {};
   double energy[kLanes] = {};
   for (int l = 0; l < count; ++l) {
     at[l] = members[l]->work.presetAt;
     force[l] = members[l]->work.presetForce;
-    stiffness[l] = members[l]->work.stiffness;
   }
-  members[0]->model->polynomial.evaluateLanes(at, count, energy, force, stiffnessLanes, afterStiffness(scratch, r));
-  unpackSymmetric(stiffnessLanes, r, count, stiffness);
+  members[0]->model->polynomial.evaluateLanes(at, count, energy, force, stiffnessLanes, afterFactors(scratch, r));
+  // Each member's K on its own, in one pass over the lanes.
+  const size_t P = pairs(r);
+  double* own = memberStiffness(scratch, r);
+  for (size_t p = 0; p < P; ++p)
+    for (int l = 0; l < count; ++l) own[l * P + p] = stiffnessLanes[p * kLanes + l];
   for (int l = 0; l < count; ++l) {
+    members[l]->work.presetStiffness = own + l * P;
     members[l]->work.presetEnergy = energy[l];
     members[l]->work.presetValid = true;
     members[l]->work.presetDefinite = false;
@@ -177,7 +169,8 @@ void stepNewtonGroup(qv_instance* const* group, const int* index, int count, dou
     scales[fixedCount] = newtonSystem(s, c1, c2);
     fixed[fixedCount++] = &s;
   }
-  if (fixedCount > 0) factoriseGroup(fixed, fixedCount, scales, evaluateTogether(fixed, fixedCount, scratch));
+  if (fixedCount > 0)
+    factoriseGroup(fixed, fixedCount, scales, evaluateTogether(fixed, fixedCount, scratch), factorLanes(scratch, group[0]->r));
   NewmarkNewton step[kLanes];
   qv_step_status status[kLanes];
   bool going[kLanes];
@@ -191,7 +184,7 @@ void stepNewtonGroup(qv_instance* const* group, const int* index, int count, dou
     factor[l] = going[l] ? takePresetFactor(s, newtonSystem(s, c1, c2)) : LaneFactor{};
   }
   // The evaluation's scratch is free again: the right-hand sides go there.
-  solveTogether(group, factor, count, afterStiffness(scratch, group[0]->r));
+  solveTogether(group, factor, count, afterFactors(scratch, group[0]->r));
   for (int l = 0; l < count; ++l) {
     qv_instance& s = *group[l];
     if (going[l]) status[l] = endNewmarkNewton(s, step[l], factor[l].A != nullptr);
@@ -230,13 +223,13 @@ void stepMinimizingTogether(qv_instance* const* instances, Next next, double* sc
     for (int l = 0; l < active; ++l) scales[l] = minimizerSystem(*member[l], predictor[l]);
     double* K = evaluateTogether(member, active, scratch);
     // The evaluation's scratch is free again.
-    markDefinite(member, active, K, afterStiffness(scratch, member[0]->r));
-    factoriseGroup(member, active, scales, K);
+    markDefinite(member, active, K, afterFactors(scratch, member[0]->r));
+    factoriseGroup(member, active, scales, K, factorLanes(scratch, member[0]->r));
     for (int l = 0; l < active; ++l) task[l].resume();
     // The Newton directions the steps take from there, solved together.
     LaneFactor factor[kLanes];
     for (int l = 0; l < active; ++l) factor[l] = task[l].awaitedSolve();
-    solveTogether(member, factor, active, afterStiffness(scratch, member[0]->r));
+    solveTogether(member, factor, active, afterFactors(scratch, member[0]->r));
     for (int l = 0; l < active; ++l)
       if (factor[l].A) task[l].solved(), task[l].resume();
     for (int l = 0; l < active;) {
@@ -262,7 +255,7 @@ void stepMinimizingTogether(qv_instance* const* instances, Next next, double* sc
 size_t stepManyScratchPerJob(const qv_model& model) {
   if (!model.polynomial.groups()) return 64;  // nothing is stepped in groups: one line, never read
   const int r = model.info.r;
-  const size_t doubles = pairs(r) * kLanes + ReducedPolynomial::laneScratchSize(r);
+  const size_t doubles = 3 * pairs(r) * kLanes + ReducedPolynomial::laneScratchSize(r);
   return (doubles * sizeof(double) + 63) & ~size_t(63);
 }
 

@@ -63,10 +63,12 @@ qv_step_status minimizedInstead(qv_instance& s, StepFunction minimizing, bool st
   s.work.presetValid = false;
   s.work.presetFactor = LaneFactor{};
   // Its damping starts from this state, as after qv_instance_set_state: fixed Newton steps keep no D.
-  if (stiffnessAtState)
-    dampWithStiffness(s, s.work.stiffness, s.dampingStiffness);
-  else
+  if (stiffnessAtState) {
+    dampWithStiffness(s, wholeStiffness(s), s.dampingStiffness);
+  } else {
+    s.work.stiffnessPacked = nullptr;  // evaluated anew at the state below
     s.dampingStiffnessAtState(s.dampingStiffness);
+  }
   const qv_step_status status = minimizing(s);
   s.lastStep.energy_removed += settled.energy_removed;
   s.lastStep.held_back |= settled.held_back;
@@ -78,7 +80,7 @@ qv_step_status endFixedNewton(qv_instance& s, double budget, StepFunction minimi
   if (!s.withinBounds(s.end.q, s.end.v, s.end.a)) return minimizedInstead(s, minimizing, false);
   const int r = s.r;
   // Damping with the last iterate's K, as the iterations damped.
-  budget -= dampingShare(s, s.work.stiffness);
+  budget -= dampingShare(s);
   if (s.exactEndChecks > 0) {
     --s.exactEndChecks;
     double elastic = elasticEnergy(*s.model, s.config.elasticity, s.end.q, s.work.polynomialScratch);

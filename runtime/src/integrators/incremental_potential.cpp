@@ -58,9 +58,9 @@ public:
   bool direction(const double* jacobian, bool& failed) {
     SystemScales scales = minimizerSystem(s_, p_);
     const double diagonal = scales.identity;
+    const double* K = wholeStiffness(s_);
     double largest = 0;
-    for (int i = 0; i < r_; ++i)
-      largest = std::fmax(largest, std::fabs(s_.work.stiffness[i * r_ + i]) + std::fabs(jacobian[i * r_ + i]));
+    for (int i = 0; i < r_; ++i) largest = std::fmax(largest, std::fabs(K[i * r_ + i]) + std::fabs(jacobian[i * r_ + i]));
     double mu = 0;
     for (int attempt = 0; attempt < 40; ++attempt) {
       scales.identity = diagonal + mu;
@@ -140,11 +140,25 @@ bool holdToBudget(qv_instance& s, double budget, const double* start, double sta
   return drawBack;
 }
 
-double dampingShare(qv_instance& s, const double* K) {
+namespace {
+
+// `damp` puts C v_mid into s.work.damping.
+template <class Damp>
+double dampingShareBy(qv_instance& s, Damp damp) {
   double* mid = s.work.midpointVelocity;
   for (int i = 0; i < s.r; ++i) mid[i] = 0.5 * (s.v[i] + s.end.v[i]);
-  dampingForces(s, K, mid, s.work.damping);
+  damp(mid, s.work.damping);
   return s.config.time_step * std::fmax(dot(mid, s.work.damping, s.r), 0.0);
+}
+
+} // namespace
+
+double dampingShare(qv_instance& s, const double* K) {
+  return dampingShareBy(s, [&](const double* v, double* out) { dampingForces(s, K, v, out); });
+}
+
+double dampingShare(qv_instance& s) {
+  return dampingShareBy(s, [&](const double* v, double* out) { dampingForces(s, v, out); });
 }
 
 void MinimizeTask::begin(qv_instance& s, const StepPredictor& p) {
@@ -260,11 +274,13 @@ void MinimizeTask::finish() {
   s.energySlack = s.lastStep.held_back ? 0.0 : std::fmax(0.0, budget_ - stepEnergy(s, s.end.q, s.end.v, elastic_));
   s.elasticEnergyAtState = elastic_;
   // The next step damps with K at this end: the last evaluation's (at_'s), unless the budget moved x.
-  if (s.lastStep.held_back)
+  if (s.lastStep.held_back) {
+    s.work.stiffnessPacked = nullptr;
     evaluateElasticity(*s.model, s.config.elasticity, s.end.q, nullptr, s.work.force, s.work.stiffness, s.work.polynomialScratch);
+  }
   const bool definite = at_.definite && !s.lastStep.held_back;
   s.work.presetDefinitesTaken += definite;
-  dampWithStiffness(s, s.work.stiffness, s.dampingStiffness, definite);
+  dampWithStiffness(s, wholeStiffness(s), s.dampingStiffness, definite);
   phase_ = Phase::Done;
 }
 

@@ -111,6 +111,7 @@ bool holdToBudget(qv_instance& s, double budget, const double* start, double sta
 // What damping dissipates over the step from s.v to s.end.v: h v_mid^T C v_mid, C = alpha I + beta K
 // (exact for the trapezoidal rule's linear damping; never below zero, should K be indefinite).
 double dampingShare(qv_instance& s, const double* K);
+double dampingShare(qv_instance& s);  // with K(q) last evaluated (dampingForces(s, v, out))
 
 // begin(), resume() until done, status().
 qv_step_status minimizeStep(qv_instance& s, const StepPredictor& predictor);
