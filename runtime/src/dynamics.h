@@ -15,8 +15,8 @@ namespace quiver::rt {
 // (the group's presetDefinite).
 bool elasticityAt(qv_instance& s, const double* q, double* energy, double* force);
 
-// K(q) last evaluated, as a whole r x r matrix: s.work.stiffness, copied there from the group's
-// lanes first if it is still in them.
+// K(q) last evaluated, as a whole r x r matrix: s.work.stiffness, copied there first from the
+// group's scratch if it is still there (s.work.stiffnessPacked).
 const double* wholeStiffness(qv_instance& s);
 
 // Fills s.work.force = R(q) + S(q) and s.work.stiffness = K(q); returns J.
@@ -27,7 +27,7 @@ const double* evaluateForces(qv_instance& s, const double* q);
 // rows as axpys (SIMD across i), each sum over j in order, instead of r chains of r dependent
 // multiply-adds.
 void dampingForces(const qv_instance& s, const double* K, const double* v, double* out);
-// The same with K(q) last evaluated, read from the group's lanes when it is still in them.
+// The same with K(q) last evaluated, read packed from the group's scratch while it is there.
 void dampingForces(const qv_instance& s, const double* v, double* out);
 
 // The fixed Newton step's (I + c1 C + c2 (K + J)), C = alpha I + beta K(q). Fused explicitly: the

@@ -282,7 +282,8 @@ void qv_instance::moveFrame() {
 qv_step_status qv_instance::endStep(qv_step_status status) {
   work.presetValid = false;
   work.presetFactor = quiver::rt::LaneFactor{};
-  work.stiffnessPacked = nullptr;  // the group's lanes are overwritten after its step; no step reads K before evaluating it
+  // The group's scratch is overwritten after its step, and no step reads K before evaluating it.
+  work.stiffnessPacked = nullptr;
   loads.endStep();
   if (status == QV_STEP_RESET || !healthy()) {
     rest();

@@ -49,7 +49,7 @@ struct StepBuffers {
   double* stateForceSink = nullptr;    // where stepEnergy() lets the state forces add the force it does not need
   double* polynomialScratch = nullptr;
   // A group stepped together (step_many.h) evaluates each member's polynomial at the point its
-  // step will evaluate next: R(q) and E(q) here, K(q) in the group's lanes. The step's next elastic
+  // step will evaluate next: R(q) and E(q) here, K(q) in the group's scratch. The step's next elastic
   // evaluation takes them when it is at exactly that point (elasticityAt(), dynamics.h).
   double* presetAt = nullptr;
   double* presetForce = nullptr;
