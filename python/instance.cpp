@@ -458,7 +458,7 @@ arrays, or written into out=(positions, normals). ValueError for a model without
 
   m.def("step_many", &stepMany, py::arg("instances"), py::arg("threads") = 1,
         R"(Steps many instances of one Model once each (qv_instances_step): implicit Newmark StVK instances in groups
-of 8 evaluated together (SIMD across instances), the rest as alone. States agree with Instance.step to
+of 16 evaluated together (SIMD across instances), the rest as alone. States agree with Instance.step to
 rounding (1e-9 of the largest coordinate after 2 s of changing loads on the suite's bar), not bit for
 bit, and do not depend on `threads` when every instance is groupable. threads > 1 runs the groups on
 that many threads (made for the call). The GIL is released while stepping. Returns each one's
