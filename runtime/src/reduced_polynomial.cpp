@@ -106,25 +106,37 @@ QV_HOT void packedSymmetricProduct(const C* Q, size_t n, const double* x, double
   }
 }
 
-// y[i] = sum_k B_ik q_k, k in order, over the rows of a blocked matrix (ReducedPolynomial::kBlock;
-// y has room for the last block's padding rows). Four blocks per sweep: four independent running
-// sums, where one block alone would wait on the multiply-add latency at every k.
-QV_HOT void blockedProduct(const double* B, int r, size_t rows, const double* q, double* y) {
-  constexpr size_t G = 8, N = 4;
-  const size_t stride = static_cast<size_t>(r) * G, blocks = (rows + G - 1) / G;
-  for (size_t b = 0; b < blocks; b += N) {
-    const size_t n = blocks - b < N ? blocks - b : N;
-    double sum[N][G] = {};
-    for (int k = 0; k < r; ++k) {
-      const double qk = q[k];
-      for (size_t m = 0; m < n; ++m)
+// y[i] = sum_k B_ik q_k, k in order, for the N row blocks at B (ReducedPolynomial::kBlock rows
+// each, `stride` doubles apart): N independent running sums, where one block alone would wait on
+// the multiply-add latency at every k.
+template <size_t N>
+[[gnu::always_inline]] inline void blockedSweep(const double* B, size_t stride, int r, const double* q, double* y) {
+  constexpr size_t G = ReducedPolynomial::kBlock;
+  double sum[N][G] = {};
+  for (int k = 0; k < r; ++k) {
+    const double qk = q[k];
+    for (size_t m = 0; m < N; ++m)
 #pragma omp simd
-        for (size_t g = 0; g < G; ++g) sum[m][g] += B[(b + m) * stride + k * G + g] * qk;
-    }
-    for (size_t m = 0; m < n; ++m)
-#pragma omp simd
-      for (size_t g = 0; g < G; ++g) y[(b + m) * G + g] = sum[m][g];
+      for (size_t g = 0; g < G; ++g) sum[m][g] += B[m * stride + k * G + g] * qk;
   }
+  for (size_t m = 0; m < N; ++m)
+#pragma omp simd
+    for (size_t g = 0; g < G; ++g) y[m * G + g] = sum[m][g];
+}
+
+// The same over all the rows of a blocked matrix (y has room for the last block's padding rows), N
+// blocks per sweep: eight (eight vectors of eight running sums) with AVX-512's 32 registers, four
+// (eight vectors of four) with AVX2's 16. The number of blocks a sweep takes is fixed at compile
+// time: a count known only at run time (the last sweep's) had GCC test it at every k, which took
+// the cubic part's product to about twice its multiply-adds' time.
+template <size_t N>
+QV_HOT void blockedProduct(const double* B, int r, size_t rows, const double* q, double* y) {
+  constexpr size_t G = ReducedPolynomial::kBlock;
+  const size_t stride = static_cast<size_t>(r) * G, blocks = (rows + G - 1) / G;
+  size_t b = 0;
+  for (; b + N <= blocks; b += N) blockedSweep<N>(B + b * stride, stride, r, q, y + b * G);
+  for (; b + 2 <= blocks; b += 2) blockedSweep<2>(B + b * stride, stride, r, q, y + b * G);
+  if (b < blocks) blockedSweep<1>(B + b * stride, stride, r, q, y + b * G);
 }
 
 // The energy's monomials (ReducedPolynomial::monomials_) come in runs, each against a tail of the
@@ -373,7 +385,7 @@ void ReducedPolynomial::evaluate(const double* q, double* energy, double* force,
     wide ? packedSymmetricProduct<8>(q32_, n, x, y4) : packedSymmetricProduct<4>(q32_, n, x, y4);
   else
     wide ? packedSymmetricProduct<8>(q64_, n, x, y4) : packedSymmetricProduct<4>(q64_, n, x, y4);
-  blockedProduct(t_, r, P, q, y3);
+  wide ? blockedProduct<8>(t_, r, P, q, y3) : blockedProduct<4>(t_, r, P, q, y3);
   const double e = stiffness ? assemble<true>(k2_, y3, y4, r, q, stiffness, Rq)
                              : assemble<false>(k2_, y3, y4, r, q, nullptr, Rq);
   if (force)
