@@ -105,7 +105,7 @@ void PeakFma(benchmark::State& state, int width) {
 // sit (L1, L2, L3 or memory), in the same run. The buffer is read again and again, as the
 // evaluation reads its coefficients. Until 2026-11-28 this read was plain scalar code, which GCC
 // compiled to SSE2 (16-byte loads into four sums): below L2's bandwidth, so the floor was too high
-// for whatever fits in L2 (0.57 MB at r = 30, float32: 6.0 us, against 2.8 us for this read).
+// for whatever fits in L2 (0.57 MB at r = 30, float32: 6.0 us, against 3.2-3.3 us for this read).
 template <class vec, int W>
 __attribute__((always_inline)) inline double streamChains(const double* x, size_t n) {  // in its callers' targets
   vec acc[8] = {};
