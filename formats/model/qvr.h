@@ -190,4 +190,12 @@ struct ModelView {
 // left unchanged. Never throws (beyond std::bad_alloc while building a message); safe on any input.
 bool parseModel(const void* data, size_t size, ModelView& out, std::string& error);
 
+// Whether the energy of a model `view` parsed from `data` rises without bound along each mode's
+// own axis: every c_iiii > 0, as in any St.Venant-Kirchhoff energy (mode i's Green strain grows as
+// q_i^2). Else false, with `error` naming the coefficient, its byte offset and its value: the
+// energy falls without bound, and no simulation of it can stay near rest. A necessary condition,
+// cheap enough for every load (the runtime refuses such a model; its steps stay in a bounded box
+// of q whatever the energy). Not part of parseModel, whose contract is the format's.
+bool energyRisesAlongModes(const void* data, const ModelView& view, std::string& error);
+
 } // namespace quiver

@@ -501,4 +501,21 @@ bool parseModel(const void* data, size_t size, ModelView& out, std::string& erro
   return Parser(static_cast<const unsigned char*>(data), size, error).parse(out);
 }
 
+bool energyRisesAlongModes(const void* data, const ModelView& view, std::string& error) {
+  const uint32_t r = view.info.r;
+  const size_t quartic = monomialCount2(r) + monomialCount3(r);
+  const size_t section = static_cast<size_t>(reinterpret_cast<const char*>(view.energy) - static_cast<const char*>(data));
+  for (uint32_t i = 0; i < r; ++i) {
+    const size_t at = quartic + monomialIndex4(r, i, i, i, i);
+    if (view.energy[at] > 0) continue;
+    const std::string mode = std::to_string(i);
+    error = sectionName(kEnergyCoefficients) + " at byte " + std::to_string(section) + ": the coefficient of q" + mode +
+            "^4 (value " + std::to_string(at) + ", byte " + std::to_string(section + 8 * at) + ") is " +
+            number(view.energy[at]) + ", not positive: the energy falls without bound along mode " + mode +
+            ", as no St.Venant-Kirchhoff energy does";
+    return false;
+  }
+  return true;
+}
+
 } // namespace quiver

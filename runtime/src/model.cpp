@@ -118,7 +118,7 @@ qv_result loadModel(const void* data, size_t size, const qv_model_config& config
                     qv_model** out, char* message, size_t messageSize) {
   ModelView view;
   std::string error;
-  if (!parseModel(data, size, view, error)) {
+  if (!parseModel(data, size, view, error) || !energyRisesAlongModes(data, view, error)) {
     report(message, messageSize, error);
     return QV_ERROR_FORMAT;
   }

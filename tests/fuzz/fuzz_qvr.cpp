@@ -3,8 +3,9 @@
 // as it is, and "repaired" (file size field and every checksum recomputed) so that mutations reach
 // the checks behind the checksums. A refusal must say why. An accepted model is copied element by
 // element through the view's pointers (ASan checks every one), must pass the writer's validation,
-// and must parse back to a model that formats to the same bytes; then the runtime loads it, and
-// evaluates and steps it once, flying too where it can (so its load-time expansion and first step meet hostile numbers
+// and must parse back to a model that formats to the same bytes; then the runtime loads it (or
+// refuses it, with the same message, where its energy falls along a mode: energyRisesAlongModes()),
+// and evaluates and steps it once, flying too where it can (so its load-time expansion and first step meet hostile numbers
 // too); anything else aborts.
 #include <cstddef>
 #include <cstdint>
@@ -29,10 +30,17 @@ std::unique_ptr<unsigned char[]> exactCopy(const std::string& bytes) {
 }
 
 // The runtime on an accepted model: load, evaluate at a small q, create an instance, one step.
-void runtimeSmoke(const void* data, size_t size) {
+// `refusal`: the runtime's message for an energy that falls along a mode (energyRisesAlongModes()),
+// or empty where it must load.
+void runtimeSmoke(const void* data, size_t size, const std::string& refusal) {
   qv_model* model = nullptr;
-  char message[256];
-  if (qv_model_load_memory(data, size, nullptr, nullptr, &model, message, sizeof message) != QV_OK) std::abort();
+  char message[1024];
+  const qv_result loaded = qv_model_load_memory(data, size, nullptr, nullptr, &model, message, sizeof message);
+  if (!refusal.empty()) {
+    if (loaded != QV_ERROR_FORMAT || model || refusal != message) std::abort();
+    return;
+  }
+  if (loaded != QV_OK) std::abort();
   qv_model_info info;
   qv_model_get_info(model, &info);
   std::vector<double> q(info.r, 1e-3), force(info.r), scratch(qv_model_scratch_size(model) / sizeof(double) + 1);
@@ -71,7 +79,9 @@ void check(const std::string& input) {
   if (!quiver::parseModel(formatted.get(), bytes.size(), again, error) ||
       quiver::formatModel(quiver::copyModel(again)) != bytes)
     std::abort();
-  runtimeSmoke(data.get(), input.size());
+  std::string falls;
+  energyRisesAlongModes(data.get(), view, falls);
+  runtimeSmoke(data.get(), input.size(), falls);
 }
 
 } // namespace

@@ -241,6 +241,44 @@ TEST(QvrValidation, ModelInfoAndArraysAreChecked) {
 } // namespace
 // The FIDELITY section: the bake's report round-trips (NaN for "not measured" included) and every
 // field is checked: counts, the size they imply, names, values.
+// energyRisesAlongModes: every c_iiii > 0, else the first that is not, by its place in the file.
+// The quartic (i, i, i, i) is found by enumerating QVR.md's sorted tuples in lexicographic order.
+TEST(QvrValidation, AnEnergyThatFallsAlongAModeIsNamed) {
+  test::Counts counts;
+  counts.r = 4;
+  counts.vertexCount = 6;
+  ModelContents c = test::syntheticModel(counts);
+  const size_t r = counts.r, quadratic = r * (r + 1) / 2, cubic = r * (r + 1) * (r + 2) / 6;
+  std::vector<size_t> diagonal;  // index of (i, i, i, i) among the quartic tuples
+  size_t index = 0;
+  for (size_t i = 0; i < r; ++i)
+    for (size_t j = i; j < r; ++j)
+      for (size_t k = j; k < r; ++k)
+        for (size_t l = k; l < r; ++l, ++index)
+          if (i == l) diagonal.push_back(index);
+  for (size_t i = 0; i < r; ++i) c.energy[quadratic + cubic + diagonal[i]] = 1.0 + i;
+  const auto check = [](const ModelContents& contents) {
+    test::AlignedFile file(formatModel(contents));
+    ModelView view;
+    std::string error;
+    EXPECT_TRUE(file.parse(view, error)) << error;
+    return energyRisesAlongModes(file.data(), view, error) ? std::string() : error;
+  };
+  EXPECT_EQ(check(c), "");
+  const std::string f = formatModel(c);
+  const size_t section = test::getLE(f, entry(1) + 8, 8);  // ENERGY_COEFFICIENTS, second in type order
+  for (double value : {0.0, -0.0, -2.5}) {
+    ModelContents falling = c;
+    const size_t at = quadratic + cubic + diagonal[2];
+    falling.energy[at] = value;
+    falling.energy[quadratic + cubic + diagonal[3]] = -1;  // a later one is not reported
+    EXPECT_EQ(check(falling), "ENERGY_COEFFICIENTS at byte " + std::to_string(section) + ": the coefficient of q2^4 (value " +
+                                  std::to_string(at) + ", byte " + std::to_string(section + 8 * at) + ") is " +
+                                  (value == -2.5 ? "-2.5" : std::signbit(value) ? "-0" : "0") +
+                                  ", not positive: the energy falls without bound along mode 2, as no St.Venant-Kirchhoff energy does");
+  }
+}
+
 TEST(QvrValidation, TheFidelityReportRoundTripsAndIsChecked) {
   ModelContents c = test::syntheticModel();
   c.fidelityCases = {{"own weight", 0.003, 0.4}, {"twist 30", kNaN, kNaN}};
