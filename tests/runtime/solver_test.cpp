@@ -4,12 +4,18 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
+#include <deque>
+#include <fstream>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include <Eigen/Dense>
 
+#include "formats/model/qvr_writer.h"
 #include "tests/runtime/runtime_fixture.h"
 
 using namespace quiver;
@@ -127,6 +133,99 @@ TEST(Solver, NoBoundedLoadResetsItNonFiniteInputDoes) {
   EXPECT_EQ(qv_instance_step(inst.s), QV_STEP_RESET);
   EXPECT_EQ(stateOf(inst.s, r, 0).norm(), 0.0);
   EXPECT_EQ(qv_instance_step(inst.s), QV_STEP_OK);
+}
+
+// A crafted file's energy that falls without bound where no single mode's does: the test model
+// with the coefficient of q0^2 q1^2 set to -100 (c_0000 + c_1111), so that E falls as -t^4 along
+// q0 = q1 = t (each mode's own axis still rises: the loader takes it). Let go past the ridge, the
+// state used to run off to infinity and reset to rest (15 resets in 600 steps of a 30-mode beam).
+// Now every step stays in the box of max_displacement: finite, not at rest, no vertex past
+// max_displacement, and, with no loads, never more energy than it started with; one by one and in
+// a group, with both solvers and both implicit integrators.
+TEST(Solver, AnEnergyThatFallsWithoutBoundStaysInTheBoxAndNeverResets) {
+  std::ifstream in(QUIVER_RUNTIME_MODEL, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ModelView view;
+  std::string error;
+  ASSERT_TRUE(parseModel(bytes.data(), bytes.size(), view, error)) << error;
+  ModelContents contents = copyModel(view);
+  const uint32_t r = view.info.r;
+  double* quartic = contents.energy.data() + monomialCount2(r) + monomialCount3(r);
+  quartic[monomialIndex4(r, 0, 0, 1, 1)] = -100 * (quartic[monomialIndex4(r, 0, 0, 0, 0)] + quartic[monomialIndex4(r, 1, 1, 1, 1)]);
+  const std::string crafted = formatModel(contents);
+  std::vector<double> aligned(crafted.size() / 8 + 1);  // parseModel's 8-byte alignment
+  std::memcpy(aligned.data(), crafted.data(), crafted.size());
+  qv_model* model = nullptr;
+  char message[512] = "";
+  ASSERT_EQ(qv_model_load_memory(aligned.data(), crafted.size(), nullptr, nullptr, &model, message, sizeof message), QV_OK) << message;
+  {  // One whose energy falls along a mode's own axis is refused, and the message says where.
+    ModelContents falling = contents;
+    double* own = falling.energy.data() + monomialCount2(r) + monomialCount3(r) + monomialIndex4(r, 1, 1, 1, 1);
+    *own = -*own;
+    const std::string bad = formatModel(falling);
+    std::vector<double> buffer(bad.size() / 8 + 1);
+    std::memcpy(buffer.data(), bad.data(), bad.size());
+    qv_model* refused = nullptr;
+    EXPECT_EQ(qv_model_load_memory(buffer.data(), bad.size(), nullptr, nullptr, &refused, message, sizeof message), QV_ERROR_FORMAT);
+    EXPECT_EQ(refused, nullptr);
+    EXPECT_NE(std::string(message).find("the coefficient of q1^4"), std::string::npos) << message;
+    EXPECT_NE(std::string(message).find("falls without bound along mode 1"), std::string::npos) << message;
+  }
+  qv_model_info info;
+  qv_model_get_info(model, &info);
+  // Past the ridge along q0 = q1: the first t (doubling) where E(t, t, 0, ...) falls.
+  std::vector<double> q(r, 0.0), scratch(qv_model_scratch_size(model) / sizeof(double) + 1);
+  const auto energyAt = [&](double t) {
+    q[0] = q[1] = t;
+    double e = 0;
+    qv_model_evaluate(model, q.data(), &e, nullptr, nullptr, scratch.data());
+    return e;
+  };
+  double t = 1e-6;
+  while (!(energyAt(2 * t) < energyAt(t))) t *= 2;
+  ASSERT_TRUE(std::isfinite(t) && t < 1e3) << "the crafted energy falls along q0 = q1";
+  energyAt(4 * t);  // q: past the ridge, falling
+  const std::vector<double> start = q;
+  const double* rest = qv_model_rest_positions(model);
+  for (qv_integrator integrator : {QV_INTEGRATOR_IMPLICIT_NEWMARK, QV_INTEGRATOR_BACKWARD_EULER})
+    for (qv_solver solver : {QV_SOLVER_MINIMIZE, QV_SOLVER_NEWTON})
+      for (bool group : {false, true}) {
+        const std::string what = std::string(qv_integrator_name(integrator)) + ", " + qv_solver_name(solver) +
+                                 (group ? ", in a group" : ", alone");
+        qv_instance_config config;
+        qv_instance_config_init(&config, model);
+        config.integrator = integrator;
+        config.solver = solver;
+        config.rayleigh_alpha = config.rayleigh_beta = 0;
+        std::deque<Instance> instances;  // not movable
+        std::vector<qv_instance*> all;
+        for (int i = 0; i < (group ? QV_GROUP_SIZE : 1); ++i) {
+          all.push_back(instances.emplace_back(model, config).s);
+          qv_instance_set_state(all.back(), start.data(), nullptr, nullptr);
+        }
+        const double first = totalEnergy(all[0]);
+        std::vector<char> groupScratch(qv_instances_step_scratch_size(model, 1) + 64);
+        void* aligned64 = groupScratch.data() + (64 - reinterpret_cast<uintptr_t>(groupScratch.data()) % 64) % 64;
+        std::vector<qv_step_status> statuses(all.size());
+        std::vector<float> positions(3 * static_cast<size_t>(info.vertex_count));
+        for (int step = 0; step < 300; ++step) {
+          if (group)
+            ASSERT_EQ(qv_instances_step(all.data(), int(all.size()), nullptr, aligned64, groupScratch.size() - 64, statuses.data()), QV_OK);
+          else
+            statuses[0] = qv_instance_step(all[0]);
+          for (size_t i = 0; i < all.size(); ++i) ASSERT_NE(statuses[i], QV_STEP_RESET) << what << ", step " << step;
+        }
+        for (qv_instance* s : all) {
+          EXPECT_TRUE(stateOf(s, int(r), 0).allFinite() && stateOf(s, int(r), 1).allFinite()) << what;
+          EXPECT_GT(stateOf(s, int(r), 0).norm(), 0.0) << what << ": not at rest";
+          EXPECT_LE(totalEnergy(s), first + 1e-9 * std::fabs(first)) << what;
+          qv_instance_positions(s, positions.data());
+          double farthest = 0;
+          for (size_t k = 0; k < positions.size(); ++k) farthest = std::fmax(farthest, std::fabs(positions[k] - rest[k]));
+          EXPECT_LE(farthest, config.max_displacement * (1 + 1e-6)) << what;  // float positions
+        }
+      }
+  qv_model_destroy(model);
 }
 
 TEST(Solver, TheReportSaysWhatTheStepDid) {

@@ -161,6 +161,9 @@ typedef enum qv_solver {
                              until the gradient is below newton_tolerance or after newton_iterations; the total
                              energy never grows within a step (what the integrator would add is taken out of the
                              velocity). No bounded load can make it run away: it resets only on non-finite input.
+                             Its iterates stay within max_displacement (a box through |q|, or |q| at the step's
+                             start where that is farther), so that a model whose energy falls without bound (a
+                             damaged or crafted file the loader's checks let through) stays finite too.
                              Rayleigh damping C = alpha I + beta K(q) uses K at the step's start (lagged, shifted to
                              positive definite where compression made it indefinite), so it damps a bent object as
                              the Newton iterations do. Costs about 2x a fixed Newton step where one iteration
@@ -212,7 +215,8 @@ typedef struct qv_instance_config {
   int max_constraints;       /* penalty constraint slots (drag springs, pinned groups), 0..64; default 4 */
   double max_displacement;   /* m; a step that may move a vertex farther (a bound through |q|): QV_SOLVER_NEWTON takes it with the minimising
                                 solver instead (so every step, at about 3x the cost, while a load holds the object
-                                past it), central differences reset the instance; default 100 x the model's diagonal */
+                                past it), whose iterates stay within it; central differences reset the instance;
+                                default 100 x the model's diagonal */
   qv_elasticity elasticity;  /* default QV_ELASTICITY_STVK */
   int free_flight;           /* 1: the object flies in a moving frame (qv_rigid_state; needs has_rigid_body); default 0 */
   int max_contacts;          /* in flight: contact points solved per step, 0..4096; default 64. When more touch, each

@@ -19,6 +19,11 @@ double dot(const double* a, const double* b, int n) {
 
 double norm(const double* a, int n) { return std::sqrt(dot(a, a, n)); }
 
+// x clamped to the box |x_i| <= bound (NaN stays NaN, so that non-finite input still resets).
+void boxed(int r, double bound, const double* x, double* out) {
+  for (int i = 0; i < r; ++i) out[i] = x[i] > bound ? bound : x[i] < -bound ? -bound : x[i];
+}
+
 class Minimizer {
 public:
   // qt in s.work.predictor, v0 in s.work.predictorVelocity; v(x) into s.end.v.
@@ -171,6 +176,9 @@ void MinimizeTask::begin(qv_instance& s, const StepPredictor& p) {
   // under the old loads is not owed under the new ones.
   if (s.loads.changedSinceLastStep()) s.energySlack = 0;
   budget_ = stepEnergy(s, s.q, s.v, s.elasticEnergyAtState) + s.energySlack;
+  box_ = s.maxQ;
+  for (int i = 0; i < s.r; ++i) box_ = std::fmax(box_, std::fabs(s.q[i]));
+  boxed(s.r, box_, s.end.q, s.end.q);
   iteration_ = 0;
   status_ = QV_STEP_OK;
   phase_ = Phase::First;
@@ -201,7 +209,7 @@ void MinimizeTask::resume() {
       ++s.lastStep.line_search_cuts;
       length_ *= 0.5;
       if (++cut_ < 30) {
-        for (int i = 0; i < r; ++i) s.work.trial[i] = s.end.q[i] + length_ * s.work.correction[i];
+        trialPoint();
         return;
       }
       phase_ = Phase::Restore;  // no length lowered Phi: x stays, with its forces and velocity
@@ -261,9 +269,15 @@ void MinimizeTask::step() {
   roundoff_ = 1e-12 * std::fabs(at_.phi);
   length_ = 1;
   cut_ = 0;
-  for (int i = 0; i < r; ++i) s.work.trial[i] = s.end.q[i] + s.work.correction[i];
+  trialPoint();
   phase_ = Phase::Trial;
   point_ = s.work.trial;
+}
+
+void MinimizeTask::trialPoint() {
+  qv_instance& s = *s_;
+  for (int i = 0; i < s.r; ++i) s.work.trial[i] = s.end.q[i] + length_ * s.work.correction[i];
+  boxed(s.r, box_, s.work.trial, s.work.trial);
 }
 
 void MinimizeTask::finish() {

@@ -85,12 +85,18 @@ private:
   enum class Phase { First, Solve, Trial, Restore, Done };
   void iterate();   // at an accepted iterate: stop, or a Newton direction
   void step();      // along the direction in s.work.correction: its first trial point
+  void trialPoint();  // s.work.trial at length_ along it, kept in the box
   void finish();    // the energy budget
   qv_instance* s_ = nullptr;
   StepPredictor p_{};
   Phase phase_ = Phase::Done;
   const double* point_ = nullptr;  // where resume() evaluates
   int iteration_ = 0, cut_ = 0;
+  // Every iterate stays in the box |x_i| <= box_ = max(maxQ, |q|_inf at the start): a model whose
+  // energy is not bounded below (a damaged or crafted file) would run off to infinity and reset.
+  // A baked model's steps never reach it (maxQ: 100 model diagonals by default); a state already
+  // past maxQ (set from outside) is not pulled in.
+  double box_ = 0;
   double budget_ = 0, elastic_ = 0, trialElastic_ = 0, gradient_ = 0, slope_ = 0, roundoff_ = 0, length_ = 0;
   PhiPoint at_, trial_;
   LaneFactor factor_;  // Phase::Solve: the group's factor the direction is solved in, unless solved
