@@ -169,15 +169,20 @@ struct qv_instance {
   qv_step_status finishStep();  // moveFrame(), the integrator's step, endStep()
   void moveFrame();              // in flight, the frame's move over the step, before q's
   qv_step_status endStep(qv_step_status status);  // the per-step loads are spent; a blown-up state resets
+  // In flight, after q's step: what the frame's turn added to the centrifugal potential
+  // (RigidFrame::turnExcess()) beyond what earlier turns took (RigidFrame::turnCredit) is taken out
+  // of q' (as far as q' holds it).
+  void takeOutTurnExcess();
   // The snapshot: r, then q, v, a, E(q) and the energy slack, then in flight the frame (position,
-  // orientation, velocity, angular momentum, last body omega), then D's upper triangle row by row,
+  // orientation, velocity, angular momentum, turn credit), then D's upper triangle row by row,
   // then the last step's per-step forces and whether a persistent load changed since (1 or 0), then
   // the fixed Newton account (the elastic allowance, the previous E(q) and q, the exact end checks
   // left), as doubles: all a step reads beyond the caller's calls.
   size_t snapshotSize() const {
     const size_t n = static_cast<size_t>(r);
-    return sizeof(double) * (3 * n + 3 + (flying() ? 16 : 0) + n * (n + 1) / 2 + 2 * n + 4);
+    return sizeof(double) * (3 * n + 3 + frameSnapshotSize() + n * (n + 1) / 2 + 2 * n + 4);
   }
+  size_t frameSnapshotSize() const { return flying() ? 14 : 0; }
   void saveSnapshot(double* out) const;
   bool restoreSnapshot(const double* in);
   void energies(double* kinetic, double* elastic) const;

@@ -12,17 +12,24 @@
 //   deformation does. x then moves with the new v.
 // - The angular velocity follows from L: omega = R I(q)^-1 (R^T L - h), with the deformed
 //   inertia I(q) and the deformation's own angular momentum h = \int rho p x p' (the model's
-//   RIGID_BODY moments give both exactly). R turns by exp(h omega), omega at the midpoint turn.
+//   RIGID_BODY moments give both exactly). R turns by the implicit midpoint rule (move()), which
+//   keeps |L_b| and the rotational energy exactly at any step.
 // - The deformation feels the frame's inertial forces -U^T M (omega x (omega x p) + omega' x p
-//   + 2 omega x p'), with omega = I(q)^-1 L_b and L_b = R^T L - h held over the step:
+//   + 2 omega x p'), with omega = I(q)^-1 L_b and L_b = R^T L - h held over the step. Of them:
 //   - centrifugal, as the potential V(q) = L_b . I(q)^-1 L_b / 2 (the rotational energy at that
 //     angular momentum), whose gradient is exactly the centrifugal force. It is a state force
 //     (loads.h): implicit, in the minimising step's energy, so that spinning and vibrating trade
 //     energy without making any;
-//   - Euler, omega' x p, with omega' by difference over the last step: explicit, a per-step force;
+//   - Euler, omega' x p, is left out: the basis is M-orthogonal to the rigid rotations, so
+//     U^T M (omega' x (X - c)) = 0 and what is left, omega' x U q, is second order in the
+//     deformation. Taken explicitly (omega' by difference over the last step) it pumped energy
+//     into fast spins (a bar at 200 rad/s in 1/480 s steps: 190-fold in 2.3 s);
 //   - Coriolis, 2 omega x p', is left out: it is gyroscopic (no work), second order in the
 //     deformation for a basis M-orthogonal to the rigid motions, and taken explicitly it pumps
 //     energy into the vibration (measured: a tumbling bar's energy grew 7x in 5 s).
+//   What the step's turn and the deformation's new h change in V between the steps is settled
+//   after q's step in free flight (turnExcess(), qv_instance::takeOutTurnExcess()), so that a
+//   fast spin cannot feed the vibration step after step; with contacts in reach, they take it out.
 //   External forces act on all three: F and x_v x f on the frame, U_v^T R^T f on q.
 #include "model.h"
 
@@ -37,7 +44,6 @@ struct RigidFrame {
   double bodyOmega[3] = {};        // omega in the body frame at the current state
   double inertia[9] = {};          // I(q), body frame, at the current state
   double internal[3] = {};         // h = \int rho p x p', body frame, at the current state
-  double lastBodyOmega[3] = {};    // at the start of the last step: omega' by difference
   double force[3] = {}, torque[3] = {};  // this step's, world; torque about x
   double gravity[3] = {};          // persistent acceleration, m/s^2, world
   double homePosition[3] = {};     // where a reset puts the frame (the last set state), at rest
@@ -45,6 +51,10 @@ struct RigidFrame {
   double* moments = nullptr;       // 9 x r: y_ab = \int rho p_a U_b at the current state
   double* products = nullptr;      // 9 x r: A_ab q at the centrifugal potential's trial q
   double heldMomentum[3] = {};     // L_b = R^T L - h, body frame, held over a step (holdSpin())
+  double heldRotation[9] = {};     // R, h and L when it was held: turnExcess() compares with them
+  double heldInternal[3] = {};
+  double heldAngularMomentum[3] = {};
+  double turnCredit = 0;           // J the turns took from the centrifugal potential, which later turns may give back
 
   static size_t scratchDoubles(int r) { return 18 * static_cast<size_t>(r); }
   // Takes its scratch from `scratch` (scratchDoubles(r) doubles).
@@ -58,16 +68,25 @@ struct RigidFrame {
   void setWorldOmega(const double omega[3]);
   // Holds L_b = R^T L - h for this step's centrifugal potential (refresh() first).
   void holdSpin();
+  // What the step's turn and the deformation's new h added to the centrifugal potential at the
+  // step's end (q, q'), beyond what torques and contacts did: V(q) at the L_b the next step holds,
+  // less V(q) at R^T L - h with the R and h this step held (holdSpin()), or 0 within rounding.
+  // refresh()es at (q, q').
+  double turnExcess(const qv_model& model, const double* q, const double* qdot);
+  // Whether L changed since holdSpin() (a torque or a contact impulse).
+  bool spinChangedSinceHold() const {
+    return angularMomentum[0] != heldAngularMomentum[0] || angularMomentum[1] != heldAngularMomentum[1] ||
+           angularMomentum[2] != heldAngularMomentum[2];
+  }
   // The centrifugal potential V(q) = L_b . I(q)^-1 L_b / 2: adds its gradient to `resisting` (the
   // resisting sign of loads.h) and its Gauss-Newton Hessian (omega held) to `jacobian`; returns V.
   double addCentrifugal(const qv_model& model, const double* q, double* resisting, double* jacobian) const;
-  // Adds the Euler force -U^T M (omega' x p) on q (refresh() first), with omega' over `h`.
-  void addInertialForces(const qv_model& model, double h, double* reducedForce) const;
   // The frame's share of the step: momenta by this step's force, torque and gravity (accelerate),
   // then x and R (move); contact impulses go between the two.
   void accelerate(const qv_model& model, double h);
   void move(double h);
-  // Orientation `from` turned by t |omega| about the world axis omega.
+  // Orientation `from` turned by the Cayley map of t omega: 2 atan(t |omega| / 2) about the world
+  // axis omega.
   void turn(const double from[4], const double omega[3], double t);
   // World position of body point p: x + R p.
   void toWorld(const double p[3], double out[3]) const;

@@ -37,7 +37,7 @@ void fallAsleep(qv_instance& s, int group) {
   std::memset(f.velocity, 0, sizeof f.velocity);
   std::memset(f.angularMomentum, 0, sizeof f.angularMomentum);
   f.refresh(*s.model, s.q, s.v);
-  std::memcpy(f.lastBodyOmega, f.bodyOmega, sizeof f.lastBodyOmega);
+  f.turnCredit = 0;
 }
 
 // Measures (block null) or places the world's arrays; returns the block's size.
