@@ -70,6 +70,13 @@ struct TestModel {
   }
 };
 
+// Kinetic plus elastic energy (in flight, the frame's motion included).
+inline double totalEnergy(const qv_instance* s) {
+  double kinetic = 0, elastic = 0;
+  qv_instance_energies(s, &kinetic, &elastic);
+  return kinetic + elastic;
+}
+
 // An instance owned for the length of a test.
 struct Instance {
   qv_instance* s = nullptr;

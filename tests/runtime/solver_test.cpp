@@ -20,6 +20,7 @@
 
 using namespace quiver;
 using test::Instance;
+using test::totalEnergy;
 
 namespace {
 
@@ -27,12 +28,6 @@ Eigen::VectorXd stateOf(const qv_instance* s, int r, int part) {
   Eigen::VectorXd q(r), v(r), a(r);
   qv_instance_get_state(s, q.data(), v.data(), a.data());
   return part == 0 ? q : part == 1 ? v : a;
-}
-
-double totalEnergy(const qv_instance* s) {
-  double kinetic = 0, elastic = 0;
-  qv_instance_energies(s, &kinetic, &elastic);
-  return kinetic + elastic;
 }
 
 } // namespace

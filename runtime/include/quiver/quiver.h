@@ -99,7 +99,8 @@ QV_API void qv_model_config_init(qv_model_config* config);
    `config` and `allocator` may be NULL for the defaults and the C heap (an allocator given needs both
    functions). On failure *model is NULL and, when `message` is not NULL, it receives a NUL-terminated
    description (file, section, offset, what is wrong; or which argument is invalid), truncated to
-   `message_size` bytes. */
+   `message_size` bytes. Beyond the format, an energy that falls without bound along a mode's own axis
+   is refused too (QV_ERROR_FORMAT; formats/model/QVR.md, Validation). */
 QV_API qv_result qv_model_load_file(const char* path, const qv_model_config* config, const qv_allocator* allocator,
                                     qv_model** model, char* message, size_t message_size);
 QV_API qv_result qv_model_load_memory(const void* data, size_t size, const qv_model_config* config,
@@ -336,7 +337,8 @@ QV_API void qv_instance_set_state(qv_instance* instance, const double* q, const 
    are finite (but for the last step's forces, where a step that reset may leave one that is not)
    and that its damping stiffness is positive definite (QV_ERROR_INVALID_ARGUMENT
    otherwise, the instance unchanged). Restoring also restores whether a persistent load had changed since that step, so
-   set loads after restoring, as the calls being repeated would. Saving uses the instance's scratch
+   set loads after restoring, as the calls being repeated would. The layout may change between runtime
+   versions (a flying instance's did after 0.13): the size check refuses another's. Saving uses the instance's scratch
    (QV_SOLVER_NEWTON: it evaluates the state), so save one instance from one thread at a time. */
 QV_API size_t qv_instance_snapshot_size(const qv_instance* instance);
 QV_API void qv_instance_save_snapshot(const qv_instance* instance, void* snapshot);
