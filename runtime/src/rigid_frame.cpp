@@ -121,20 +121,17 @@ void RigidFrame::setWorldOmega(const double omega[3]) {
 void RigidFrame::holdSpin() {
   rotateBack(rotation, angularMomentum, heldMomentum);
   for (int c = 0; c < 3; ++c) heldMomentum[c] -= internal[c];
-  std::memcpy(heldRotation, rotation, sizeof heldRotation);
-  std::memcpy(heldInternal, internal, sizeof heldInternal);
   std::memcpy(heldAngularMomentum, angularMomentum, sizeof heldAngularMomentum);
 }
 
 double RigidFrame::turnExcess(const qv_model& model, const double* q, const double* qdot) {
   refresh(model, q, qdot);
-  double next[3], held[3], w[3], v[3];
+  double next[3], w[3], v[3];
   rotateBack(rotation, angularMomentum, next);
-  rotateBack(heldRotation, angularMomentum, held);
-  for (int c = 0; c < 3; ++c) next[c] -= internal[c], held[c] -= heldInternal[c];
+  for (int c = 0; c < 3; ++c) next[c] -= internal[c];
   solve3(inertia, next, w);
-  solve3(inertia, held, v);
-  const double after = 0.5 * dot(next, w, 3), before = 0.5 * dot(held, v, 3);
+  solve3(inertia, heldMomentum, v);
+  const double after = 0.5 * dot(next, w, 3), before = 0.5 * dot(heldMomentum, v, 3);
   // Within rounding, none: it would only amplify the rounding of q' where q' is small.
   return std::fabs(after - before) > 1e-12 * (after + before) ? after - before : 0.0;
 }

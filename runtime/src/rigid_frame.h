@@ -51,9 +51,7 @@ struct RigidFrame {
   double* moments = nullptr;       // 9 x r: y_ab = \int rho p_a U_b at the current state
   double* products = nullptr;      // 9 x r: A_ab q at the centrifugal potential's trial q
   double heldMomentum[3] = {};     // L_b = R^T L - h, body frame, held over a step (holdSpin())
-  double heldRotation[9] = {};     // R, h and L when it was held: turnExcess() compares with them
-  double heldInternal[3] = {};
-  double heldAngularMomentum[3] = {};
+  double heldAngularMomentum[3] = {};  // L when it was held (spinChangedSinceHold())
   double turnCredit = 0;           // J the turns took from the centrifugal potential, which later turns may give back
 
   static size_t scratchDoubles(int r) { return 18 * static_cast<size_t>(r); }
@@ -69,9 +67,9 @@ struct RigidFrame {
   // Holds L_b = R^T L - h for this step's centrifugal potential (refresh() first).
   void holdSpin();
   // What the step's turn and the deformation's new h added to the centrifugal potential at the
-  // step's end (q, q'), beyond what torques and contacts did: V(q) at the L_b the next step holds,
-  // less V(q) at R^T L - h with the R and h this step held (holdSpin()), or 0 within rounding.
-  // refresh()es at (q, q').
+  // step's end (q, q'), with L as held (no torque or contact since holdSpin()): V(q) at the L_b the
+  // next step holds, less V(q) at the L_b this step held, or 0 within rounding. refresh()es at
+  // (q, q').
   double turnExcess(const qv_model& model, const double* q, const double* qdot);
   // Whether L changed since holdSpin() (a torque or a contact impulse).
   bool spinChangedSinceHold() const {
