@@ -188,7 +188,8 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
                                     ? basisInputHash(derived ? derivativesHash : modesHash, s.basis.settings)
                                     : userBasisInputHash(in.hash, s.basis.userBasis);
   const ReducedBasis basis = stages.run("basis", [&] {
-    return bakeBasis(ctx, s.basis, userBasis, system.mass, layout, modes, derivatives, *archive, basisHash);
+    return bakeBasis(ctx, s.basis, userBasis, system.mass, layout, modes, derivatives,
+                     objectAmplitude(in.mesh.mesh, in.perTet), *archive, basisHash);
   });
   stages.report(describeBasis(basis));
 

@@ -8,6 +8,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
+#include "common/rigid_body.h"
 #include "formats/npy.h"
 #include "precompute/checkpoint.h"
 #include "precompute/input_hash.h"
@@ -64,9 +65,12 @@ int achievableRank(int wanted, int available, const BasisSettings& settings, con
   return available;
 }
 
-// Mass-PCA through the small Gram matrix A^T M A = V D V^T: U = A V_r D_r^{-1/2}.
+// Mass-PCA through the small Gram matrix A^T M A = V D V^T: U = A V_r D_r^{-1/2}. A derivative is
+// a displacement per squared amplitude, a mode one per amplitude: each derivative is taken at
+// `amplitude` so that both are displacements and the set is the same whatever the units.
 Eigen::MatrixXd massPca(Mat mass, const DofLayout& layout, const LinearModes& modes,
-                        const ModalDerivatives& derivatives, const BasisSettings& settings, ReducedBasis& out) {
+                        const ModalDerivatives& derivatives, double amplitude, const BasisSettings& settings,
+                        ReducedBasis& out) {
   const int k = static_cast<int>(modes.eigenvalues.size());
   const int m = k + static_cast<int>(derivatives.pairs.size());
   const double l1 = modes.eigenvalues[0];
@@ -74,7 +78,8 @@ Eigen::MatrixXd massPca(Mat mass, const DofLayout& layout, const LinearModes& mo
   for (int i = 0; i < k; ++i) A.col(i) = modes.vectors.col(i) * (l1 / modes.eigenvalues[i]);
   for (size_t p = 0; p < derivatives.pairs.size(); ++p) {
     const auto [i, j] = derivatives.pairs[p];
-    A.col(k + static_cast<Eigen::Index>(p)) = derivatives.vectors.col(static_cast<Eigen::Index>(p)) * derivativeWeight(modes, i, j);
+    A.col(k + static_cast<Eigen::Index>(p)) =
+        derivatives.vectors.col(static_cast<Eigen::Index>(p)) * (amplitude * derivativeWeight(modes, i, j));
   }
   const Eigen::MatrixXd gram = innerProducts(A, multiply(mass, A, layout), layout.comm());
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(gram);
@@ -125,13 +130,19 @@ Eigen::MatrixXd modesThenDerivatives(Mat mass, const DofLayout& layout, const Li
 
 } // namespace
 
+double objectAmplitude(const TetMesh& mesh, const std::vector<Material>& perTet) {
+  return std::sqrt(rigidBodyMoments(mesh, perTet, Eigen::MatrixXd(3 * mesh.vertexCount(), 0)).secondMoment.trace());
+}
+
 ReducedBasis buildBasis(Mat mass, const DofLayout& layout, const LinearModes& modes,
-                        const ModalDerivatives& derivatives, const BasisSettings& settings) {
+                        const ModalDerivatives& derivatives, double amplitude, const BasisSettings& settings) {
   if (settings.rank < 1) throw std::runtime_error("basis rank r must be at least 1");
+  if (settings.kind == BasisKind::Pca && !(amplitude > 0 && std::isfinite(amplitude)))
+    throw std::runtime_error("basis (pca): the object's amplitude " + std::to_string(amplitude) + " is not positive");
   ReducedBasis out;
   const int k = static_cast<int>(modes.eigenvalues.size());
   switch (settings.kind) {
-    case BasisKind::Pca: out.vectors = massPca(mass, layout, modes, derivatives, settings, out); break;
+    case BasisKind::Pca: out.vectors = massPca(mass, layout, modes, derivatives, amplitude, settings, out); break;
     case BasisKind::KeepModes:
       out.vectors = modesThenDerivatives(mass, layout, modes, derivatives, settings, out.warning);
       break;
@@ -229,11 +240,11 @@ Eigen::MatrixXd loadUserBasis(MPI_Comm comm, const std::string& spec, const Chec
 
 ReducedBasis bakeBasis(const BakeContext& ctx, const BasisRequest& request, const Eigen::MatrixXd& user, Mat mass,
                        const DofLayout& layout, const LinearModes& modes, const ModalDerivatives& derivatives,
-                       Archive& archive, const std::string& inputHash) {
+                       double amplitude, Archive& archive, const std::string& inputHash) {
   ReducedBasis basis;
   std::string source;
   if (request.userBasis.empty()) {
-    basis = buildBasis(mass, layout, modes, derivatives, request.settings);
+    basis = buildBasis(mass, layout, modes, derivatives, amplitude, request.settings);
     source = request.settings.kind == BasisKind::Pca ? "modes+derivatives" : basisKindName(request.settings.kind);
   } else {
     bool wasOrthonormal = true;

@@ -3,7 +3,11 @@
 // from the bake's own vectors (--basis), or the user's (--basis-from):
 // - pca (default; Barbič & James 2005): linear modes scaled by lambda_1 / lambda_i and modal
 //   derivatives scaled by lambda_1^2 / (lambda_i lambda_j), then mass-PCA: the r dominant
-//   directions of that set in the M inner product. Derivatives with i != j carry an extra sqrt(2):
+//   directions of that set in the M inner product. Each derivative is also taken at the amplitude
+//   of the object's own size, ||X - c||_M (objectAmplitude()): a derivative is a displacement
+//   per squared amplitude and a mode one per amplitude, so without it the basis depended on the
+//   object's size and density (a bar 7x as long or 40x as dense got another basis; the demo
+//   beam's amplitude is 0.92, near the 1 used before). Derivatives with i != j carry an extra sqrt(2):
 //   Psi_ij stands for both Psi_ij and Psi_ji, and with that weight the basis no longer depends on
 //   how an eigensolver picks vectors inside a repeated eigenvalue's eigenspace. Buys: the best
 //   r-dimensional fit to the weighted set, so large bending; but it may drop higher modes (the
@@ -23,7 +27,9 @@
 #include <Eigen/Core>
 #include <petscmat.h>
 
+#include "common/material.h"
 #include "common/mesh_checks.h"
+#include "common/tet_mesh.h"
 #include "precompute/archive/archive.h"
 #include "precompute/bake_context.h"
 #include "precompute/dof_layout.h"
@@ -50,10 +56,15 @@ struct ReducedBasis {
   std::string warning;                   // why r is smaller than asked, or ""
 };
 
-// Collective. `derivatives` may be empty for BasisKind::Modes. Throws when the recipe yields fewer
-// than r vectors and settings.exactRank is set.
+// The object's size in the mass norm, sqrt(\int rho |X - c|^2) about its centre of mass c: the
+// modal amplitude that moves it by as much as its own extent.
+double objectAmplitude(const TetMesh& mesh, const std::vector<Material>& perTet);
+
+// Collective. `derivatives` may be empty for BasisKind::Modes; `amplitude`, objectAmplitude(), is
+// used by BasisKind::Pca. Throws when the recipe yields fewer than r vectors and
+// settings.exactRank is set.
 ReducedBasis buildBasis(Mat mass, const DofLayout& layout, const LinearModes& modes,
-                        const ModalDerivatives& derivatives, const BasisSettings& settings);
+                        const ModalDerivatives& derivatives, double amplitude, const BasisSettings& settings);
 
 // The stage as the bake runs it: the recipe from the modes (and derivatives), or the user's basis
 // (`userBasis` not empty: FILE.npy or FILE.h5:/dataset, given loaded as `user`, loadUserBasis()),
@@ -65,7 +76,7 @@ struct BasisRequest {
 };
 ReducedBasis bakeBasis(const BakeContext& ctx, const BasisRequest& request, const Eigen::MatrixXd& user, Mat mass,
                        const DofLayout& layout, const LinearModes& modes, const ModalDerivatives& derivatives,
-                       Archive& archive, const std::string& inputHash);
+                       double amplitude, Archive& archive, const std::string& inputHash);
 
 // A user basis (--basis-from FILE.npy of shape (3N, r), or FILE.h5:/dataset of shape (r, N, 3), N
 // in the mesh file's vertex order) as a full 3n x r matrix in the loaded mesh's vertex order.
@@ -82,7 +93,7 @@ double massOrthonormalize(Mat mass, const DofLayout& layout, Eigen::MatrixXd& U)
 // Checkpoint: group /basis. Input hash: the derivatives' (the modes' for BasisKind::Modes), r, the
 // recipe and the stage's version tag; for a user basis, the mesh stage's, the basis's spec and a
 // version tag of its own.
-inline constexpr const char* kBasisVersion = "basis 1";
+inline constexpr const char* kBasisVersion = "basis 2";
 inline constexpr const char* kUserBasisVersion = "user basis 1";
 std::string basisInputHash(const std::string& vectorsHash, const BasisSettings& settings);
 std::string userBasisInputHash(const std::string& meshHash, const std::string& spec);

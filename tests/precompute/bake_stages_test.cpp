@@ -33,19 +33,21 @@ struct Problem {
   // Dense references over the free DOFs in vertex order.
   std::vector<int> freeRows;  // rows of the full 3n system that are free
   Eigen::MatrixXd K, M;
+  double amplitude = 0;  // ||X - c||_M from the whole mesh's consistent mass
   std::unique_ptr<StVKForceModel> model;
 
   // A 0.6 x 0.1 x 0.15 bar (unequal sides: no repeated eigenvalues) of 6 x 1 x 2 cells unless
-  // `cells` says otherwise, two materials, clamped at x = 0 unless `free`.
-  explicit Problem(bool free, const Eigen::Vector3i& cells = {6, 1, 2}) {
+  // `cells` says otherwise, two materials, clamped at x = 0 unless `free`; `scale` times as long
+  // and `denser` times as dense.
+  explicit Problem(bool free, const Eigen::Vector3i& cells = {6, 1, 2}, double scale = 1, double denser = 1) {
     int size = 1;
     MPI_Comm_size(MPI_COMM_WORLD, &size);
-    mesh = makeBoxMesh({0.6, 0.1, 0.15}, {cells.x(), cells.y(), cells.z()});
+    mesh = makeBoxMesh({0.6 * scale, 0.1 * scale, 0.15 * scale}, {cells.x(), cells.y(), cells.z()});
     for (int t = 0; t < mesh.tetCount(); ++t) {
       Material m;
       m.youngsModulus = t % 3 ? 1e6 : 3e6;
       m.poissonRatio = 0.4;
-      m.density = t % 2 ? 1000 : 1300;
+      m.density = (t % 2 ? 1000 : 1300) * denser;
       perTet.push_back(m);
     }
     if (!free)
@@ -64,6 +66,14 @@ struct Problem {
         for (int c = 0; c < 3; ++c) freeRows.push_back(3 * v + c);
     K = Kfull(freeRows, freeRows);
     M = Mfull(freeRows, freeRows);
+    Eigen::VectorXd X(3 * mesh.vertexCount()), ones = Eigen::VectorXd::Zero(3 * mesh.vertexCount());
+    for (int v = 0; v < mesh.vertexCount(); ++v) X.segment<3>(3 * v) = mesh.vertices[v];
+    for (int a = 0; a < 3; ++a) {
+      Eigen::VectorXd e = Eigen::VectorXd::Zero(X.size());
+      for (int v = 0; v < mesh.vertexCount(); ++v) e(3 * v + a) = 1;
+      X -= e * (e.dot(Mfull * X) / e.dot(Mfull * e));  // about the centre of mass
+    }
+    amplitude = std::sqrt(X.dot(Mfull * X));
   }
 
   LinearModes modes(int count) const {
@@ -367,7 +377,8 @@ TEST_P(BakeStages, BasisIsTheDenseMassPcaAndMassOrthonormal) {
   const ModalDerivatives d = p.derivatives(modes);
   BasisSettings bs;
   bs.rank = 5;
-  ReducedBasis basis = buildBasis(p.system.mass, *p.layout, modes, d, bs);
+  EXPECT_NEAR(objectAmplitude(p.mesh, p.perTet), p.amplitude, 1e-12 * p.amplitude);
+  ReducedBasis basis = buildBasis(p.system.mass, *p.layout, modes, d, p.amplitude, bs);
   const Eigen::MatrixXd U = p.dense(basis.vectors);
   EXPECT_LT((U.transpose() * p.M * U - Eigen::MatrixXd::Identity(5, 5)).cwiseAbs().maxCoeff(), 1e-10);
 
@@ -378,7 +389,8 @@ TEST_P(BakeStages, BasisIsTheDenseMassPcaAndMassOrthonormal) {
   for (int i = 0; i < 3; ++i) A.col(i) = phi.col(i) * l1 / modes.eigenvalues[i];
   for (int q = 0; q < 6; ++q) {
     const int i = d.pairs[q][0], j = d.pairs[q][1];
-    A.col(3 + q) = psi.col(q) * (i == j ? 1.0 : std::sqrt(2.0)) * l1 * l1 / (modes.eigenvalues[i] * modes.eigenvalues[j]);
+    A.col(3 + q) = psi.col(q) * p.amplitude * (i == j ? 1.0 : std::sqrt(2.0)) * l1 * l1 /
+                   (modes.eigenvalues[i] * modes.eigenvalues[j]);
   }
   Eigen::LLT<Eigen::MatrixXd> llt(p.M);
   Eigen::MatrixXd LtA = llt.matrixU() * A;
@@ -386,6 +398,20 @@ TEST_P(BakeStages, BasisIsTheDenseMassPcaAndMassOrthonormal) {
   const Eigen::MatrixXd Uref = llt.matrixU().solve(svd.matrixU().leftCols(5));
   for (int i = 0; i < 5; ++i) EXPECT_NEAR(basis.singularValues[i], svd.singularValues()[i], 1e-9 * svd.singularValues()[0]);
   EXPECT_LT(subspaceGap(U, Uref, p.M), 1e-7);
+}
+
+// The same shape 7 times as long and 40 times as dense, in the units an artist's file might use,
+// must get the same basis: only the mass norm changes, by sqrt(40 * 7^3), not the directions.
+TEST_P(BakeStages, PcaBasisIsTheSameWhateverTheSizeAndDensity) {
+  const bool free = GetParam();
+  const double scale = 7, denser = 40;
+  Problem a(free), b(free, {6, 1, 2}, scale, denser);
+  BasisSettings bs;
+  bs.rank = 5;
+  const LinearModes ma = a.modes(3), mb = b.modes(3);
+  const Eigen::MatrixXd Ua = a.dense(buildBasis(a.system.mass, *a.layout, ma, a.derivatives(ma), a.amplitude, bs).vectors);
+  const Eigen::MatrixXd Ub = b.dense(buildBasis(b.system.mass, *b.layout, mb, b.derivatives(mb), b.amplitude, bs).vectors);
+  EXPECT_LT(subspaceGap(Ua, Ub * std::sqrt(denser * scale * scale * scale), a.M), 1e-7);
 }
 
 TEST(BakeStages, UserBasisIsMassOrthonormalisedAndFlagged) {

@@ -50,7 +50,8 @@ ModelContents smallBeamModel(const SmallModelSpec& spec) {
 
   // The bake's recipe (precompute/stages/basis.h): modes scaled by lambda_1 / lambda_i, every
   // modal derivative K Psi_ij = -H(phi_i, phi_j) scaled by lambda_1^2 / (lambda_i lambda_j) (and
-  // sqrt 2 for i != j), then mass-PCA: the r dominant directions in the M inner product.
+  // sqrt 2 for i != j) at spec.derivativeAmplitude, then mass-PCA: the r dominant directions in
+  // the M inner product.
   // A free object's first six eigenpairs are its rigid motions: the modes start after them, and
   // the derivatives are solved in their M-orthogonal complement (K is singular on the rigid motions).
   const int k = spec.modes, first = spec.free ? 6 : 0;
@@ -70,7 +71,7 @@ ModelContents smallBeamModel(const SmallModelSpec& spec) {
       Eigen::VectorXd h, hf(n);
       stvk.forceHessianAtRest(full(phi.col(i)), full(phi.col(j)), h);
       for (int d = 0; d < n; ++d) hf[d] = -h[free[d]];
-      const double weight = (i == j ? 1.0 : std::sqrt(2.0)) * l1 * l1 / (eigenvalues[i] * eigenvalues[j]);
+      const double weight = spec.derivativeAmplitude * (i == j ? 1.0 : std::sqrt(2.0)) * l1 * l1 / (eigenvalues[i] * eigenvalues[j]);
       scaled.col(column++) = solve(hf) * weight;
     }
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> pca(scaled.transpose() * Mf * scaled);
