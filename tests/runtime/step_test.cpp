@@ -66,35 +66,44 @@ TEST(Step, NewmarkTrajectoryEqualsTheExactProjectionsOver1000Steps) {
   RecordProperty("largest_tip_displacement", std::to_string(tipMove.norm()));
 }
 
+// The trapezoidal rule conserves energy exactly for linear systems; with StVK's nonlinearity at a
+// 10% tip deflection it exchanges some with the discretisation, at second order: it must never
+// grow, and once the step resolves the motion the dip must shrink about fourfold with each halving
+// (measured 1.7%, 0.60%, 0.14% at 1, 0.5, 0.25 ms; 3.0%, 0.88%, 0.21% on the bake's own basis for
+// this beam). (set_state gives the consistent initial acceleration: with a = 0 the first step
+// injects ~5%.)
 TEST(Step, UndampedNewmarkKeepsEnergyBoundedOver10000Steps) {
   test::TestModel m;
   ASSERT_NE(m.model, nullptr);
   const int r = m.info.r;
-  qv_instance_config config;
-  qv_instance_config_init(&config, m.model);
-  config.rayleigh_alpha = config.rayleigh_beta = 0;
-  config.newton_iterations = 3;
-  config.time_step = 1e-3;
-  Instance inst(m.model, config);
   // Start from a large static-looking deflection along the first basis vector, at rest.
   Eigen::VectorXd q0 = Eigen::VectorXd::Zero(r);
   q0[0] = 0.1 * (m.mesh.vertices[m.tipVertex()].x()) / m.U.col(0).cwiseAbs().maxCoeff();
-  qv_instance_set_state(inst.s, q0.data(), nullptr, nullptr);
   const double initial = m.elasticEnergy(q0);
-  double lo = initial, hi = initial;
-  for (int step = 0; step < 10000; ++step) {
-    ASSERT_EQ(qv_instance_step(inst.s), QV_STEP_OK);
-    double kinetic = 0, elastic = 0;
-    qv_instance_energies(inst.s, &kinetic, &elastic);
-    lo = std::min(lo, kinetic + elastic);
-    hi = std::max(hi, kinetic + elastic);
+  double dips[3];
+  for (int halvings = 0; halvings < 3; ++halvings) {
+    qv_instance_config config;
+    qv_instance_config_init(&config, m.model);
+    config.rayleigh_alpha = config.rayleigh_beta = 0;
+    config.newton_iterations = 3;
+    config.time_step = 1e-3 / (1 << halvings);
+    Instance inst(m.model, config);
+    qv_instance_set_state(inst.s, q0.data(), nullptr, nullptr);
+    double lo = initial, hi = initial;
+    for (int step = 0; step < 10000 << halvings; ++step) {  // 10 s each
+      ASSERT_EQ(qv_instance_step(inst.s), QV_STEP_OK);
+      double kinetic = 0, elastic = 0;
+      qv_instance_energies(inst.s, &kinetic, &elastic);
+      lo = std::min(lo, kinetic + elastic);
+      hi = std::max(hi, kinetic + elastic);
+    }
+    std::printf("time step %g s: the energy within %.5f .. %.5f of its start\n", config.time_step, lo / initial,
+                hi / initial);
+    EXPECT_LT(hi, (1 + 1e-9) * initial) << config.time_step;
+    EXPECT_GT(lo, 0.95 * initial) << config.time_step;
+    dips[halvings] = 1 - lo / initial;
   }
-  // The trapezoidal rule conserves energy exactly for linear systems; with StVK's nonlinearity at a
-  // 10% tip deflection it exchanges about 1% with the discretisation but neither drifts nor grows.
-  // (set_state gave the consistent initial acceleration: with a = 0 the first step injects ~5%.)
-  EXPECT_GT(lo, 0.98 * initial);
-  EXPECT_LT(hi, 1.02 * initial);
-  RecordProperty("energy_range", std::to_string(lo / initial) + " .. " + std::to_string(hi / initial));
+  EXPECT_LT(dips[2], dips[1] / 3);
 }
 
 TEST(Step, DampedMotionComesToRestAtTheStaticEquilibrium) {
