@@ -77,6 +77,12 @@ int main(int argc, char** argv) {
          "derivatives; modes: the first r modes (precompute/stages/basis.h says what each buys)")
       ->check(CLI::IsMember(kinds))
       ->default_str("pca");
+  app.add_option("--pca-amplitude", s.basis.settings.pcaAmplitude,
+                 "pca: the amplitude the derivatives are weighed at, a fraction of the object's extent (its "
+                 "mass-weighted RMS radius): larger holds large deformations better, smaller more of the baked "
+                 "frequencies")
+      ->check(app::Positive)
+      ->capture_default_str();
   app.add_flag("--exact-rank", s.basis.settings.exactRank, "Fail rather than bake fewer than --rank vectors");
   app.add_option("--basis-from", s.basis.userBasis,
                  "Use this basis instead of modes + derivatives: FILE.npy or FILE.h5:/dataset, shape (3 x vertices, r) "
@@ -133,6 +139,9 @@ int main(int argc, char** argv) {
       if (app.count(surfaceOnly) > 0)
         std::cerr << "quiver-bake: warning: " << surfaceOnly << " applies to a surface input; " << s.mesh.path
                   << " is a tet mesh: ignored\n";
+  if (app.count("--pca-amplitude") > 0 && (s.basis.settings.kind != BasisKind::Pca || !s.basis.userBasis.empty()) &&
+      ctx.rank() == 0)
+    std::cerr << "quiver-bake: warning: --pca-amplitude applies to --basis pca: ignored\n";
   std::string error;
   try {
     checkBakeSettings(s);  // before any work

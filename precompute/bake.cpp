@@ -111,6 +111,8 @@ void checkBakeSettings(const BakeSettings& s) {
   if (std::string bad = checkMaterial(check); !bad.empty()) throw std::invalid_argument(bad);
   if (s.modes < 1) throw std::invalid_argument("--modes must be at least 1");
   if (s.basis.settings.rank < 1) throw std::invalid_argument("--rank must be at least 1");
+  if (!(s.basis.settings.pcaAmplitude > 0 && std::isfinite(s.basis.settings.pcaAmplitude)))
+    throw std::invalid_argument("--pca-amplitude must be finite and > 0");
   const int candidates =
       s.basis.settings.kind == BasisKind::Modes ? s.modes : s.modes + s.modes * (s.modes + 1) / 2;
   if (s.basis.userBasis.empty() && s.basis.settings.exactRank && s.basis.settings.rank > candidates)
@@ -189,7 +191,7 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
                                     : userBasisInputHash(in.hash, s.basis.userBasis);
   const ReducedBasis basis = stages.run("basis", [&] {
     return bakeBasis(ctx, s.basis, userBasis, system.mass, layout, modes, derivatives,
-                     objectAmplitude(in.mesh.mesh, in.perTet), *archive, basisHash);
+                     objectExtent(in.mesh.mesh, in.perTet), *archive, basisHash);
   });
   stages.report(describeBasis(basis));
 

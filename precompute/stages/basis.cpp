@@ -130,15 +130,17 @@ Eigen::MatrixXd modesThenDerivatives(Mat mass, const DofLayout& layout, const Li
 
 } // namespace
 
-double objectAmplitude(const TetMesh& mesh, const std::vector<Material>& perTet) {
+double objectExtent(const TetMesh& mesh, const std::vector<Material>& perTet) {
   return std::sqrt(rigidBodyMoments(mesh, perTet, Eigen::MatrixXd(3 * mesh.vertexCount(), 0)).secondMoment.trace());
 }
 
 ReducedBasis buildBasis(Mat mass, const DofLayout& layout, const LinearModes& modes,
-                        const ModalDerivatives& derivatives, double amplitude, const BasisSettings& settings) {
+                        const ModalDerivatives& derivatives, double extent, const BasisSettings& settings) {
   if (settings.rank < 1) throw std::runtime_error("basis rank r must be at least 1");
+  const double amplitude = settings.pcaAmplitude * extent;
   if (settings.kind == BasisKind::Pca && !(amplitude > 0 && std::isfinite(amplitude)))
-    throw std::runtime_error("basis (pca): the object's amplitude " + std::to_string(amplitude) + " is not positive");
+    throw std::runtime_error("basis (pca): the derivatives' amplitude " + std::to_string(settings.pcaAmplitude) +
+                             " x the object's extent " + std::to_string(extent) + " is not positive and finite");
   ReducedBasis out;
   const int k = static_cast<int>(modes.eigenvalues.size());
   switch (settings.kind) {
@@ -191,6 +193,7 @@ std::string basisInputHash(const std::string& vectorsHash, const BasisSettings& 
       .add(settings.rank)
       .add(std::string(basisKindName(settings.kind)))
       .add(settings.exactRank)
+      .add(settings.pcaAmplitude)
       .add(kBasisVersion)
       .hex();
 }
@@ -240,11 +243,11 @@ Eigen::MatrixXd loadUserBasis(MPI_Comm comm, const std::string& spec, const Chec
 
 ReducedBasis bakeBasis(const BakeContext& ctx, const BasisRequest& request, const Eigen::MatrixXd& user, Mat mass,
                        const DofLayout& layout, const LinearModes& modes, const ModalDerivatives& derivatives,
-                       double amplitude, Archive& archive, const std::string& inputHash) {
+                       double extent, Archive& archive, const std::string& inputHash) {
   ReducedBasis basis;
   std::string source;
   if (request.userBasis.empty()) {
-    basis = buildBasis(mass, layout, modes, derivatives, amplitude, request.settings);
+    basis = buildBasis(mass, layout, modes, derivatives, extent, request.settings);
     source = request.settings.kind == BasisKind::Pca ? "modes+derivatives" : basisKindName(request.settings.kind);
   } else {
     bool wasOrthonormal = true;

@@ -3,11 +3,13 @@
 // from the bake's own vectors (--basis), or the user's (--basis-from):
 // - pca (default; Barbič & James 2005): linear modes scaled by lambda_1 / lambda_i and modal
 //   derivatives scaled by lambda_1^2 / (lambda_i lambda_j), then mass-PCA: the r dominant
-//   directions of that set in the M inner product. Each derivative is also taken at the amplitude
-//   of the object's own size, ||X - c||_M (objectAmplitude()): a derivative is a displacement
-//   per squared amplitude and a mode one per amplitude, so without it the basis depended on the
-//   object's size and density (a bar 7x as long or 40x as dense got another basis; the demo
-//   beam's amplitude is 0.92, near the 1 used before). Derivatives with i != j carry an extra sqrt(2):
+//   directions of that set in the M inner product. Each derivative is also taken at an amplitude
+//   of pcaAmplitude times the object's extent ||X - c||_M (objectExtent()): a derivative is a
+//   displacement per squared amplitude and a mode one per amplitude, so without it the basis
+//   depended on the object's size and density (a bar 7x as long or 40x as dense got another
+//   basis). The fraction trades large deformations for frequencies (README, "basis"); its default,
+//   0.3, moves the object by about the fidelity report's loads (10-40% of its size) and held most
+//   of both on the three meshes measured. Derivatives with i != j carry an extra sqrt(2):
 //   Psi_ij stands for both Psi_ij and Psi_ji, and with that weight the basis no longer depends on
 //   how an eigensolver picks vectors inside a repeated eigenvalue's eigenspace. Buys: the best
 //   r-dimensional fit to the weighted set, so large bending; but it may drop higher modes (the
@@ -46,6 +48,7 @@ struct BasisSettings {
   int rank = 30;                          // r, basis vectors wanted (>= 1)
   BasisKind kind = BasisKind::Pca;
   bool exactRank = false;                 // fail rather than bake fewer than r vectors
+  double pcaAmplitude = 0.3;              // pca: the derivatives' amplitude, a fraction of objectExtent() (> 0)
   double maxOrthonormalityError = 1e-10;  // refuse a basis with max |U^T M U - I| above this
 };
 
@@ -56,15 +59,15 @@ struct ReducedBasis {
   std::string warning;                   // why r is smaller than asked, or ""
 };
 
-// The object's size in the mass norm, sqrt(\int rho |X - c|^2) about its centre of mass c: the
-// modal amplitude that moves it by as much as its own extent.
-double objectAmplitude(const TetMesh& mesh, const std::vector<Material>& perTet);
+// The object's extent in the mass norm, sqrt(\int rho |X - c|^2) about its centre of mass c: the
+// modal amplitude that moves it, in the mean, by its own radius of gyration.
+double objectExtent(const TetMesh& mesh, const std::vector<Material>& perTet);
 
-// Collective. `derivatives` may be empty for BasisKind::Modes; `amplitude`, objectAmplitude(), is
-// used by BasisKind::Pca. Throws when the recipe yields fewer than r vectors and
-// settings.exactRank is set.
+// Collective. `derivatives` may be empty for BasisKind::Modes; `extent`, objectExtent(), is used
+// by BasisKind::Pca. Throws when the recipe yields fewer than r vectors and settings.exactRank is
+// set.
 ReducedBasis buildBasis(Mat mass, const DofLayout& layout, const LinearModes& modes,
-                        const ModalDerivatives& derivatives, double amplitude, const BasisSettings& settings);
+                        const ModalDerivatives& derivatives, double extent, const BasisSettings& settings);
 
 // The stage as the bake runs it: the recipe from the modes (and derivatives), or the user's basis
 // (`userBasis` not empty: FILE.npy or FILE.h5:/dataset, given loaded as `user`, loadUserBasis()),
@@ -76,7 +79,7 @@ struct BasisRequest {
 };
 ReducedBasis bakeBasis(const BakeContext& ctx, const BasisRequest& request, const Eigen::MatrixXd& user, Mat mass,
                        const DofLayout& layout, const LinearModes& modes, const ModalDerivatives& derivatives,
-                       double amplitude, Archive& archive, const std::string& inputHash);
+                       double extent, Archive& archive, const std::string& inputHash);
 
 // A user basis (--basis-from FILE.npy of shape (3N, r), or FILE.h5:/dataset of shape (r, N, 3), N
 // in the mesh file's vertex order) as a full 3n x r matrix in the loaded mesh's vertex order.

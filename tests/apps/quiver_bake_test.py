@@ -153,7 +153,8 @@ class QuiverBake(unittest.TestCase):
                  ("--threads", "two", "a positive number"), ("--time-step", "inf", "a time step of at least 1e-12 s"),
                  ("--time-step", "1e-300", "a time step of at least 1e-12 s"),
                  ("--damping-ratio", "inf", "a number >= 0"), ("--degenerate-tolerance", "nan", "a number from 0 to 1"),
-                 ("--min-dihedral", "nan", "a number from 0 to 60"), ("--mesher-time-limit", "0", "a positive number")]
+                 ("--min-dihedral", "nan", "a number from 0 to 60"), ("--mesher-time-limit", "0", "a positive number"),
+                 ("--pca-amplitude", "0", "a positive number"), ("--pca-amplitude", "nan", "a positive number")]
         for option, value, expected in cases:
             with self.subTest(option=option, value=value):
                 p = subprocess.run([BAKE, self.beam, option, value, "-o", os.path.join(self.dir, "refused")],
@@ -292,19 +293,21 @@ class QuiverBake(unittest.TestCase):
         self.assertNotEqual(p.returncode, 0)
         self.assertIn("lanczos not in {block,krylov-schur}", p.stderr)
 
+    def report(self, *args):
+        """A bake's fidelity report: its cases' relative errors, and how many of how many baked
+        frequencies it holds within 1%."""
+        p = bake(1, *args, fidelity=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        line = next((l for l in p.stdout.splitlines() if "fidelity:" in l), None)
+        self.assertIsNotNone(line, p.stdout)
+        cases = {name: float(x) / 100 for name, x in re.findall(r"(own weight|pull|twist 30|twist 60) ([0-9.e+-]+)% off", line)}
+        close, total = map(int, re.search(r"(\d+) of the (\d+) baked frequencies", line).groups())
+        return cases, close, total
+
     def test_fidelity_report(self):
         """The report's numbers: a basis of every free DOF is the full model, so every case reads 0%
         and every frequency is exact; the recipes' own bases read what they lose; --no-fidelity skips it."""
-        import re
-
-        def report(*args):
-            p = bake(1, *args, fidelity=True)
-            self.assertEqual(p.returncode, 0, p.stderr)
-            line = next((l for l in p.stdout.splitlines() if "fidelity:" in l), None)
-            self.assertIsNotNone(line, p.stdout)
-            cases = {name: float(x) / 100 for name, x in re.findall(r"(own weight|pull|twist 30|twist 60) ([0-9.e+-]+)% off", line)}
-            close, total = map(int, re.search(r"(\d+) of the (\d+) baked frequencies", line).groups())
-            return cases, close, total
+        report = self.report
 
         tiny = os.path.join(self.dir, "tiny.vtu")
         subprocess.run([MESH, "beam", "--size", "1,0.1,0.1", "--cells", "3,1,1", "-o", tiny], check=True)
@@ -338,6 +341,18 @@ class QuiverBake(unittest.TestCase):
         self.assertEqual(p.returncode, 0, p.stderr)
         self.assertIn("fidelity: skipped: 18 tets is above --fidelity-max-tets 10", p.stdout)
         self.assertTrue(os.path.exists(os.path.join(self.dir, "large.qvr")))
+
+    def test_pca_amplitude_trades_frequencies_for_large_deformations(self):
+        # Derivatives weighed at a tenth of the amplitude, then at ten times it: the first basis
+        # holds every baked frequency and not the twists (measured 10 of 10, twist 30 101% off),
+        # the second the twists and not the frequencies (2 of 10, 28%).
+        common = [self.beam, "--fix", "x<min+1e-9", "--E", "1e6", "--nu", "0.45", "--density", "1000",
+                  "--modes", "10", "--rank", "16"]
+        small, small_close, total = self.report(*common, "--pca-amplitude", "0.03", "-o", os.path.join(self.dir, "small"))
+        large, large_close, _ = self.report(*common, "--pca-amplitude", "3", "-o", os.path.join(self.dir, "large"))
+        self.assertEqual(small_close, total)
+        self.assertLess(large_close, total // 2)
+        self.assertLess(large["twist 30"], 0.5 * small["twist 30"])
 
     def test_missing_mesh_is_named(self):
         p = bake(2, os.path.join(self.dir, "none.msh"), "-o", os.path.join(self.dir, "b"))

@@ -214,7 +214,7 @@ class SpreadSpectrum(unittest.TestCase):
                     self.assertGreater(hz[-1] / hz[0], 200, "the spectrum must be spread")
                     self.assertEqual(info["r"], expect)
                     self.assertEqual("warning" in p.stderr, expect < rank, p.stderr)
-            # More than the mass-PCA can resolve (61-64 of the 230 vectors): a warning and the largest r,
+            # More than the mass-PCA can resolve (57-60 of the 230 vectors): a warning and the largest r,
             # or with --exact-rank an error.
             out, p = self.bake(length, "--basis", "pca", "--rank", 100)
             info = json.loads(run(QUIVER, "info", out + ".qvr").stdout)

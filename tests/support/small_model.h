@@ -18,8 +18,9 @@ struct SmallModelSpec {
   std::array<int, 3> cells{12, 2, 2};
   double youngsModulus = 1e6, poissonRatio = 0.4, density = 1000;
   int modes = 6;         // k lowest modes and their k(k+1)/2 derivatives
-  // The amplitude (m sqrt(kg)) the derivatives are weighed at. The bake takes the object's own,
-  // ||X - c||_M (0.44 for the default beam), since its basis 2; before, 1 whatever the object. The
+  // The amplitude (m sqrt(kg)) the derivatives are weighed at. The bake takes a fraction of the
+  // object's extent, 0.3 ||X - c||_M (0.13 for the default beam), since its basis 2; before, 1
+  // whatever the object. The
   // suite's models keep 1: the runtime tests' figures were measured on those bases, and the
   // runtime must step any M-orthonormal basis (--basis-from bakes one). What it does on the
   // bake's own basis for these beams: docs/architecture.md, "Bases".
