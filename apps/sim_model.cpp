@@ -33,6 +33,7 @@ int simulateModel(const std::string& path, const SimOptions& o) {
     j["held_back_steps"] = target.heldBackSteps();
     j["minimized_steps"] = target.minimizedSteps();
     j["energy_removed_J"] = target.energyRemoved();
+    j["lowest_elastic_J"] = result.lowestElastic;
     qv_rigid_state flight;
     if (qv_instance_get_rigid_state(target.instance().get(), &flight) == QV_OK) {
       const double* v = flight.linear_velocity;
@@ -66,6 +67,8 @@ int simulateModel(const std::string& path, const SimOptions& o) {
                 << (model.info().render_vertex_count ? ", " + o.output + "_render.pvd (the render mesh)" : std::string()) << " and "
                 << o.output << ".csv\n";
   }
+  if (const std::string warning = negativeEnergyWarning(result); !warning.empty())
+    std::cerr << "quiver sim: warning: " << warning << "\n";
   if (result.failedSteps > 0) {
     std::cerr << "quiver sim: warning: the state went non-finite " << result.failedSteps
               << " times and the runtime reset it to rest (exit code 2): the load is too large for this model or "

@@ -98,6 +98,15 @@ std::vector<int> selectGroup(const TetMesh& mesh, const std::string& selector) {
   return group;
 }
 
+std::string negativeEnergyWarning(const ScenarioResult& result) {
+  if (!(result.lowestElastic < -1e-6 * result.largestEnergy)) return "";
+  std::ostringstream text;
+  text << "the elastic energy fell to " << result.lowestElastic << " J (step " << result.lowestElasticStep
+       << "): no St.Venant-Kirchhoff energy is ever negative, so this model's is not one (a crafted or damaged "
+          "file?), and its motion means nothing";
+  return text.str();
+}
+
 ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const SimOptions& o,
                            const std::function<void(int)>& afterStep) {
   const std::vector<int> group = selectGroup(mesh, o.group);
@@ -148,6 +157,8 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
     result.failedSteps += status != 0;
     double kinetic = 0, elastic = 0;
     target.energies(kinetic, elastic);
+    if (elastic < result.lowestElastic) result.lowestElastic = elastic, result.lowestElasticStep = step + 1;
+    result.largestEnergy = std::max(result.largestEnergy, kinetic + std::abs(elastic));
     csv << step + 1 << "," << (step + 1) * h << "," << kinetic << "," << elastic << "," << result.stepMicros.back() << ","
         << newton << "," << status << "\n";
     if (afterStep) afterStep(step + 1);

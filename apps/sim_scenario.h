@@ -69,7 +69,15 @@ struct ScenarioResult {
   std::vector<double> stepMicros;
   long newtonIterations = 0;
   int failedSteps = 0;  // resets (runtime) — the scenario goes on
+  double lowestElastic = 0;  // the lowest elastic energy after a step, J, and that step (1-based; 0: none below 0)
+  int lowestElasticStep = 0;
+  double largestEnergy = 0;  // the largest kinetic + |elastic| after a step, J
 };
+
+// A warning when the elastic energy went negative beyond rounding (1e-6 of the largest energy):
+// no St.Venant-Kirchhoff energy (nor a linear one) is ever negative, so the model's is not one.
+// Empty otherwise.
+std::string negativeEnergyWarning(const ScenarioResult& result);
 
 // The vertices of `mesh` that the --group `selector` picks; throws naming --group if it is malformed or picks none.
 std::vector<int> selectGroup(const TetMesh& mesh, const std::string& selector);

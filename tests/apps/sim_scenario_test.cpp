@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include "apps/sim_scenario.h"
 #include "common/box_mesh.h"
@@ -45,7 +46,11 @@ struct Recorder : ScenarioTarget {
     return failed ? 1 : 0;
   }
   void displacement(int, std::vector<double>& u) const override { u.assign(3 * 27, 0.25); }
-  void energies(double& k, double& e) const override { k = 1, e = 2; }
+  std::map<int, double> elasticAfter;  // steps taken -> elastic energy (else 2 J)
+  void energies(double& k, double& e) const override {
+    const auto it = elasticAfter.find(static_cast<int>(steps.size()) - 1);
+    k = 1, e = it == elasticAfter.end() ? 2 : it->second;
+  }
   double timeStep() const override { return 0.5; }
 };
 
@@ -137,6 +142,26 @@ TEST(Scenario, OutputFilesAndFailedStepsAreCounted) {
   EXPECT_EQ(lines[0], "step,time_s,kinetic_J,elastic_J,step_us,newton,status");
   EXPECT_EQ(lines[3].rfind("3,1.5,1,2,", 0), 0u) << lines[3];
   EXPECT_EQ(lines[3].back(), '1') << "the failed step's status";
+}
+
+// A crafted model's energy can fall below zero, which no StVK energy does: named with its step,
+// unless it is rounding (1e-6 of the largest energy).
+TEST(Scenario, ANegativeElasticEnergyIsNamedWithItsStep) {
+  SimOptions o;
+  o.steps = 5;
+  o.holdSteps = 0;
+  Recorder target;
+  target.elasticAfter = {{2, -0.25}, {3, -0.5}, {4, 4}};
+  ScenarioResult result = runScenario(target, box(), o);
+  EXPECT_EQ(result.lowestElastic, -0.5);
+  EXPECT_EQ(result.lowestElasticStep, 3);
+  EXPECT_EQ(result.largestEnergy, 5);  // 1 J kinetic + 4 J
+  EXPECT_NE(negativeEnergyWarning(result).find("fell to -0.5 J (step 3)"), std::string::npos) << negativeEnergyWarning(result);
+  Recorder rounding;
+  rounding.elasticAfter = {{2, -1e-9}};
+  result = runScenario(rounding, box(), o);
+  EXPECT_EQ(result.lowestElasticStep, 2);
+  EXPECT_EQ(negativeEnergyWarning(result), "");
 }
 
 TEST(Scenario, AGroupThatSelectsNothingIsNamed) {
