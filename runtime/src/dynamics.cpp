@@ -83,7 +83,7 @@ QV_HOT void dampingForces(const qv_instance& s, const double* v, double* out) {
   for (int i = 0; i < r; ++i) out[i] = alpha * v[i] + beta * out[i];
 }
 
-const double* wholeStiffness(qv_instance& s) {
+const double* wholeStiffness(const qv_instance& s) {
   if (const double* K = s.work.stiffnessPacked) {
     const int r = s.r;
     for (int a = 0; a < r; ++a) {
@@ -101,6 +101,14 @@ LaneFactor takePresetFactor(qv_instance& s, const SystemScales& scales) {
   s.work.presetFactor = LaneFactor{};
   s.work.presetFactorsTaken += factor.A != nullptr;
   return factor;
+}
+
+void dampAt(const qv_instance& s, const double* x, bool evaluatedAtX, double* D, bool definite) {
+  if (!evaluatedAtX) {
+    s.work.stiffnessPacked = nullptr;
+    evaluateElasticity(*s.model, s.config.elasticity, x, nullptr, s.work.force, s.work.stiffness, s.work.polynomialScratch);
+  }
+  dampWithStiffness(s, wholeStiffness(s), D, definite);
 }
 
 bool elasticityAt(qv_instance& s, const double* q, double* energy, double* force) {

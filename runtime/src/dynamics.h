@@ -17,7 +17,12 @@ bool elasticityAt(qv_instance& s, const double* q, double* energy, double* force
 
 // K(q) last evaluated, as a whole r x r matrix: s.work.stiffness, copied there first from the
 // group's scratch if it is still there (s.work.stiffnessPacked).
-const double* wholeStiffness(qv_instance& s);
+const double* wholeStiffness(const qv_instance& s);
+
+// D from K(x) into `D` (dampWithStiffness(); may be s.work.stiffness), as a minimising step that
+// ended at x leaves it: K the last evaluation's when it was at x (`evaluatedAtX`), else K(x)
+// evaluated now into s.work.stiffness (R(x) into s.work.force; a group's K pending is dropped).
+void dampAt(const qv_instance& s, const double* x, bool evaluatedAtX, double* D, bool definite = false);
 
 // Fills s.work.force = R(q) + S(q) and s.work.stiffness = K(q); returns J.
 const double* evaluateForces(qv_instance& s, const double* q);

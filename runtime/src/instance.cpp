@@ -337,7 +337,7 @@ void qv_instance::setState(const double* newQ, const double* newV, const double*
   const bool newAccount = keepsEnergyAccount() && (newQ || newV);
   if (newQ || newAccount)
     elasticEnergyAtState = quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
-  if (newQ) quiver::rt::dampWithStiffness(*this, quiver::rt::wholeStiffness(*this), dampingStiffness);
+  if (newQ) quiver::rt::dampAt(*this, q, true, dampingStiffness);  // K(q) just evaluated
   if (newA) {
     std::memcpy(a, newA, sizeof(double) * r);
   } else if (consistentA) {
@@ -352,11 +352,6 @@ void qv_instance::setState(const double* newQ, const double* newV, const double*
   }
   energySlack = 0;
   if (newAccount) openEnergyAccount(elasticEnergyAtState);
-}
-
-void qv_instance::dampingStiffnessAtState(double* D) const {
-  quiver::rt::evaluateElasticity(*model, config.elasticity, q, nullptr, work.force, work.stiffness, work.polynomialScratch);
-  quiver::rt::dampWithStiffness(*this, work.stiffness, D);
 }
 
 void qv_instance::saveSnapshot(double* out) const {
@@ -386,7 +381,7 @@ void qv_instance::saveSnapshot(double* out) const {
   // saved bits repeat the same steps.
   const double* D = dampingStiffness;
   if (!budgeted) {
-    dampingStiffnessAtState(work.stiffness);
+    quiver::rt::dampAt(*this, q, false, work.stiffness);
     D = work.stiffness;
   }
   for (int i = 0; i < r; ++i)

@@ -104,7 +104,8 @@ struct qv_instance {
   qv_step_report lastStep;
   quiver::rt::Loads loads;
   quiver::rt::EndOfStep end;
-  quiver::rt::StepBuffers work;
+  // Scratch: a snapshot (a const query) evaluates K into it too (dampAt(), dynamics.h).
+  mutable quiver::rt::StepBuffers work;
   quiver::rt::RigidFrame frame;  // in flight (config.free_flight) only
   const qv_collider* colliders = nullptr;  // the caller's (qv_instance_set_colliders)
   int colliderCount = 0;
@@ -141,10 +142,6 @@ struct qv_instance {
   // One step of the configured integrator; per-step loads are spent; a blown-up state resets.
   qv_step_status step();
   void setState(const double* q, const double* v, const double* a);
-  // D from K(q) into `D` (r x r; may be work.stiffness), as a minimising step that ended at q would
-  // leave it: for a state set from outside (setState(), a fixed Newton step the minimiser takes over).
-  // K(q) is evaluated into work.stiffness: no group's K may be pending in work.stiffnessPacked.
-  void dampingStiffnessAtState(double* D) const;
   bool flying() const { return config.free_flight != 0; }
   // How fast the step would move the contact modes under its loads so far, contact forces not yet
   // among them (modeCompliance not null): the implicit step linearised at q, into modeVelocity.

@@ -63,12 +63,7 @@ qv_step_status minimizedInstead(qv_instance& s, StepFunction minimizing, bool st
   s.work.presetValid = false;
   s.work.presetFactor = LaneFactor{};
   // Its damping starts from this state, as after qv_instance_set_state: fixed Newton steps keep no D.
-  if (stiffnessAtState) {
-    dampWithStiffness(s, wholeStiffness(s), s.dampingStiffness);
-  } else {
-    s.work.stiffnessPacked = nullptr;  // evaluated anew at the state below
-    s.dampingStiffnessAtState(s.dampingStiffness);
-  }
+  dampAt(s, s.q, stiffnessAtState, s.dampingStiffness);
   const qv_step_status status = minimizing(s);
   s.lastStep.energy_removed += settled.energy_removed;
   s.lastStep.held_back |= settled.held_back;

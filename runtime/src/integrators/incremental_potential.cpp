@@ -288,13 +288,9 @@ void MinimizeTask::finish() {
   s.energySlack = s.lastStep.held_back ? 0.0 : std::fmax(0.0, budget_ - stepEnergy(s, s.end.q, s.end.v, elastic_));
   s.elasticEnergyAtState = elastic_;
   // The next step damps with K at this end: the last evaluation's (at_'s), unless the budget moved x.
-  if (s.lastStep.held_back) {
-    s.work.stiffnessPacked = nullptr;
-    evaluateElasticity(*s.model, s.config.elasticity, s.end.q, nullptr, s.work.force, s.work.stiffness, s.work.polynomialScratch);
-  }
   const bool definite = at_.definite && !s.lastStep.held_back;
   s.work.presetDefinitesTaken += definite;
-  dampWithStiffness(s, wholeStiffness(s), s.dampingStiffness, definite);
+  dampAt(s, s.end.q, !s.lastStep.held_back, s.dampingStiffness, definite);
   phase_ = Phase::Done;
 }
 
