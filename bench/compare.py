@@ -18,6 +18,8 @@ import tempfile
 
 import numpy as np
 
+from machine import machine_line
+
 try:
     import meshio
 except ImportError:
@@ -148,6 +150,7 @@ def main():
     ap.add_argument("--meshes", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared",
                                                      "meshes"))
     args = ap.parse_args()
+    print(machine_line() + "; one thread per simulation\n")
     apps = os.path.join(args.build, "apps")
     os.makedirs(args.out, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
