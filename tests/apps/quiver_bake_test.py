@@ -393,8 +393,9 @@ class QuiverBake(unittest.TestCase):
         name = os.path.join(self.dir, "killed")
         args = [big, "--fix", "x<min+1e-9", "--E", "1e6", "--nu", "0.45", "--density", "1000", "--modes", "10",
                 "--rank", "20", "--export-npy", "--no-fidelity", "-o", name]
+        # mpirun's session folder (8 MB) in our temporary one: killed, it cannot remove it itself.
         proc = subprocess.Popen(command(2, *args), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                                stdin=subprocess.DEVNULL)
+                                stdin=subprocess.DEVNULL, env=dict(os.environ, TMPDIR=self.dir))
         for line in proc.stdout:
             if line.startswith("quiver-bake: modes:"):
                 kill_job(proc)  # mid-bake: the derivatives stage is next
