@@ -78,10 +78,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember(kinds))
       ->default_str("pca");
   app.add_option("--pca-amplitude", s.basis.settings.pcaAmplitude,
-                 "pca: the amplitude the derivatives are weighed at, a fraction of the object's extent (its "
-                 "mass-weighted RMS radius): larger holds large deformations better, smaller more of the baked "
-                 "frequencies")
-      ->check(app::Positive)
+                 "pca: the amplitude the derivatives are weighed at, a fraction of the object's extent "
+                 "||X - c||_M = sqrt(mass) x its radius of gyration: larger holds large deformations better, smaller "
+                 "more of the baked frequencies")
+      ->check(app::Between(1e-3, 1e3))
       ->capture_default_str();
   app.add_flag("--exact-rank", s.basis.settings.exactRank, "Fail rather than bake fewer than --rank vectors");
   app.add_option("--basis-from", s.basis.userBasis,
@@ -141,7 +141,10 @@ int main(int argc, char** argv) {
                   << " is a tet mesh: ignored\n";
   if (app.count("--pca-amplitude") > 0 && (s.basis.settings.kind != BasisKind::Pca || !s.basis.userBasis.empty()) &&
       ctx.rank() == 0)
-    std::cerr << "quiver-bake: warning: --pca-amplitude applies to --basis pca: ignored\n";
+    std::cerr << "quiver-bake: warning: --pca-amplitude applies to the pca recipe, not to "
+              << (s.basis.userBasis.empty() ? "--basis " + std::string(basisKindName(s.basis.settings.kind))
+                                            : "--basis-from")
+              << ": ignored\n";
   std::string error;
   try {
     checkBakeSettings(s);  // before any work

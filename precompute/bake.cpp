@@ -189,9 +189,10 @@ void runBake(const BakeContext& ctx, const BakeSettings& s) {
   const std::string basisHash = s.basis.userBasis.empty()
                                     ? basisInputHash(derived ? derivativesHash : modesHash, s.basis.settings)
                                     : userBasisInputHash(in.hash, s.basis.userBasis);
+  const bool pca = s.basis.userBasis.empty() && s.basis.settings.kind == BasisKind::Pca;
   const ReducedBasis basis = stages.run("basis", [&] {
     return bakeBasis(ctx, s.basis, userBasis, system.mass, layout, modes, derivatives,
-                     objectExtent(in.mesh.mesh, in.perTet), *archive, basisHash);
+                     pca ? objectExtent(in.mesh.mesh, in.perTet) : 0.0, *archive, basisHash);
   });
   stages.report(describeBasis(basis));
 

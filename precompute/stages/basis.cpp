@@ -8,7 +8,6 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
-#include "common/rigid_body.h"
 #include "formats/npy.h"
 #include "precompute/checkpoint.h"
 #include "precompute/input_hash.h"
@@ -131,7 +130,26 @@ Eigen::MatrixXd modesThenDerivatives(Mat mass, const DofLayout& layout, const Li
 } // namespace
 
 double objectExtent(const TetMesh& mesh, const std::vector<Material>& perTet) {
-  return std::sqrt(rigidBodyMoments(mesh, perTet, Eigen::MatrixXd(3 * mesh.vertexCount(), 0)).secondMoment.trace());
+  double mass = 0;
+  Eigen::Vector3d first = Eigen::Vector3d::Zero();
+  for (int t = 0; t < mesh.tetCount(); ++t) {
+    const double m = perTet[t].density * std::abs(signedVolume6(mesh, t)) / 6;
+    for (int i : mesh.tets[t]) first += 0.25 * m * mesh.vertices[i];
+    mass += m;
+  }
+  const Eigen::Vector3d c = first / mass;
+  // Per tet, for y linear with corner values y_i: \int |y|^2 = V / 20 (sum |y_i|^2 + |sum y_i|^2).
+  double second = 0;
+  for (int t = 0; t < mesh.tetCount(); ++t) {
+    double squares = 0;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int i : mesh.tets[t]) {
+      const Eigen::Vector3d y = mesh.vertices[i] - c;
+      squares += y.squaredNorm(), sum += y;
+    }
+    second += perTet[t].density * std::abs(signedVolume6(mesh, t)) / 6 / 20 * (squares + sum.squaredNorm());
+  }
+  return std::sqrt(second);
 }
 
 ReducedBasis buildBasis(Mat mass, const DofLayout& layout, const LinearModes& modes,
@@ -139,8 +157,8 @@ ReducedBasis buildBasis(Mat mass, const DofLayout& layout, const LinearModes& mo
   if (settings.rank < 1) throw std::runtime_error("basis rank r must be at least 1");
   const double amplitude = settings.pcaAmplitude * extent;
   if (settings.kind == BasisKind::Pca && !(amplitude > 0 && std::isfinite(amplitude)))
-    throw std::runtime_error("basis (pca): the derivatives' amplitude " + std::to_string(settings.pcaAmplitude) +
-                             " x the object's extent " + std::to_string(extent) + " is not positive and finite");
+    throw std::runtime_error("basis (pca): --pca-amplitude " + shortNumber(settings.pcaAmplitude) +
+                             " times the object's extent " + shortNumber(extent) + " is not a positive finite amplitude");
   ReducedBasis out;
   const int k = static_cast<int>(modes.eigenvalues.size());
   switch (settings.kind) {
@@ -193,7 +211,7 @@ std::string basisInputHash(const std::string& vectorsHash, const BasisSettings& 
       .add(settings.rank)
       .add(std::string(basisKindName(settings.kind)))
       .add(settings.exactRank)
-      .add(settings.pcaAmplitude)
+      .add(settings.kind == BasisKind::Pca ? settings.pcaAmplitude : 0.0)  // the others ignore it
       .add(kBasisVersion)
       .hex();
 }

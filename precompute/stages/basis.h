@@ -94,8 +94,8 @@ ReducedBasis importBasis(Mat mass, const DofLayout& layout, Eigen::MatrixXd rows
 double massOrthonormalize(Mat mass, const DofLayout& layout, Eigen::MatrixXd& U);
 
 // Checkpoint: group /basis. Input hash: the derivatives' (the modes' for BasisKind::Modes), r, the
-// recipe and the stage's version tag; for a user basis, the mesh stage's, the basis's spec and a
-// version tag of its own.
+// recipe, exactRank, pcaAmplitude (pca only) and the stage's version tag; for a user basis, the mesh
+// stage's, the basis's spec and a version tag of its own.
 inline constexpr const char* kBasisVersion = "basis 2";
 inline constexpr const char* kUserBasisVersion = "user basis 1";
 std::string basisInputHash(const std::string& vectorsHash, const BasisSettings& settings);

@@ -36,7 +36,8 @@ struct StepBuffers {
   // (step_many.h), not copied here until a reader needs the whole matrix (wholeStiffness(),
   // dynamics.h). The damping products read it there: the whole matrix written into every member
   // had cost more than both products of a fixed Newton step.
-  const double* stiffnessPacked = nullptr;
+  // Mutable: a snapshot, a const query, evaluates K into `stiffness` too (dampAt(), dynamics.h).
+  mutable const double* stiffnessPacked = nullptr;
   double* system = nullptr;       // the Newton matrix, factorised in place
   double* correction = nullptr;   // the Newton right-hand side in, the correction out
   double* damping = nullptr;      // C v (dampingForces(), dynamics.h)
@@ -104,8 +105,7 @@ struct qv_instance {
   qv_step_report lastStep;
   quiver::rt::Loads loads;
   quiver::rt::EndOfStep end;
-  // Scratch: a snapshot (a const query) evaluates K into it too (dampAt(), dynamics.h).
-  mutable quiver::rt::StepBuffers work;
+  quiver::rt::StepBuffers work;
   quiver::rt::RigidFrame frame;  // in flight (config.free_flight) only
   const qv_collider* colliders = nullptr;  // the caller's (qv_instance_set_colliders)
   int colliderCount = 0;

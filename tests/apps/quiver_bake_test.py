@@ -154,7 +154,9 @@ class QuiverBake(unittest.TestCase):
                  ("--time-step", "1e-300", "a time step of at least 1e-12 s"),
                  ("--damping-ratio", "inf", "a number >= 0"), ("--degenerate-tolerance", "nan", "a number from 0 to 1"),
                  ("--min-dihedral", "nan", "a number from 0 to 60"), ("--mesher-time-limit", "0", "a positive number"),
-                 ("--pca-amplitude", "0", "a positive number"), ("--pca-amplitude", "nan", "a positive number")]
+                 ("--pca-amplitude", "0", "a number from 0.001 to 1000"),
+                 ("--pca-amplitude", "nan", "a number from 0.001 to 1000"),
+                 ("--pca-amplitude", "1e308", "a number from 0.001 to 1000")]
         for option, value, expected in cases:
             with self.subTest(option=option, value=value):
                 p = subprocess.run([BAKE, self.beam, option, value, "-o", os.path.join(self.dir, "refused")],

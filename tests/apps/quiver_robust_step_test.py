@@ -152,8 +152,8 @@ class RobustStep(unittest.TestCase):
                     self.assertLessEqual(after.max(), released * (1 + 1e-5))  # the CSV prints 6 digits
                     # No lower bound here: after a 180-degree twist of a sliver mesh the energy the trapezoidal
                     # rule trades with the budget swings widely and the phase at any one step differs between bakes.
-                    # That the budget keeps energy (wipes no velocity) is Step.UndampedNewmarkKeepsEnergyBounded...'s
-                    # lower bound, on a model of its own.
+                    # That the budget keeps energy (wipes no velocity) is the lower bound of
+                    # Step.UndampedNewmarkEnergyDipsAtSecondOrderAndNeverGrows, on a model of its own.
 
     def test_fixed_newton_energy_stays_within_the_release_but_for_single_steps(self):
         """The fixed Newton step (one iteration) holds the same budget one step late: a step may end

@@ -66,7 +66,7 @@ struct Problem {
         for (int c = 0; c < 3; ++c) freeRows.push_back(3 * v + c);
     K = Kfull(freeRows, freeRows);
     M = Mfull(freeRows, freeRows);
-    Eigen::VectorXd X(3 * mesh.vertexCount()), ones = Eigen::VectorXd::Zero(3 * mesh.vertexCount());
+    Eigen::VectorXd X(3 * mesh.vertexCount());
     for (int v = 0; v < mesh.vertexCount(); ++v) X.segment<3>(3 * v) = mesh.vertices[v];
     for (int a = 0; a < 3; ++a) {
       Eigen::VectorXd e = Eigen::VectorXd::Zero(X.size());
@@ -413,6 +413,18 @@ TEST_P(BakeStages, PcaBasisIsTheSameWhateverTheSizeAndDensity) {
   const Eigen::MatrixXd Ua = a.dense(buildBasis(a.system.mass, *a.layout, ma, a.derivatives(ma), a.extent, bs).vectors);
   const Eigen::MatrixXd Ub = b.dense(buildBasis(b.system.mass, *b.layout, mb, b.derivatives(mb), b.extent, bs).vectors);
   EXPECT_LT(subspaceGap(Ua, Ub * std::sqrt(denser * scale * scale * scale), a.M), 1e-7);
+}
+
+// --resume reuses the polynomials (the costly stage) by this hash: the amplitude counts where the
+// recipe uses it, and only there.
+TEST(BakeStages, OnlyThePcaRecipeHashesItsAmplitude) {
+  BasisSettings a, b;
+  b.pcaAmplitude = 0.5;
+  EXPECT_NE(basisInputHash("derivatives", a), basisInputHash("derivatives", b));
+  for (BasisKind kind : {BasisKind::KeepModes, BasisKind::Modes}) {
+    a.kind = b.kind = kind;
+    EXPECT_EQ(basisInputHash("derivatives", a), basisInputHash("derivatives", b)) << basisKindName(kind);
+  }
 }
 
 TEST(BakeStages, UserBasisIsMassOrthonormalisedAndFlagged) {

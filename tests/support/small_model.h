@@ -20,10 +20,9 @@ struct SmallModelSpec {
   int modes = 6;         // k lowest modes and their k(k+1)/2 derivatives
   // The amplitude (m sqrt(kg)) the derivatives are weighed at. The bake takes a fraction of the
   // object's extent, 0.3 ||X - c||_M (0.13 for the default beam), since its basis 2; before, 1
-  // whatever the object. The
-  // suite's models keep 1: the runtime tests' figures were measured on those bases, and the
-  // runtime must step any M-orthonormal basis (--basis-from bakes one). What it does on the
-  // bake's own basis for these beams: docs/architecture.md, "Bases".
+  // whatever the object. The suite's models keep 1: the runtime tests' figures were measured on
+  // those bases, and the runtime must step any M-orthonormal basis (--basis-from bakes one). What
+  // it does on the bake's own basis for these beams: docs/architecture.md, "Bases".
   double derivativeAmplitude = 1;
   int rank = 10;         // r
   int basisPrecision = 64;
