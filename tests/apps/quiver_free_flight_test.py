@@ -34,12 +34,6 @@ class FreeFlight(unittest.TestCase):
         material = ["--E", "1e6", "--nu", "0.4", "--density", "1000", "--modes", 8, "--rank", 16, "--quiet"]
         cls.free = os.path.join(d, "free")
         run(MPIEXEC, "-n", "2", "--oversubscribe", BAKE, mesh, *material, "-o", cls.free)
-        # The pile's bars at --pca-amplitude 1: at the default 0.3 one of the twenty never falls
-        # asleep, its deformation ringing against its contacts (the elastic energy swinging 8e-3 J
-        # a step, 3 Newton iterations each, after 6 s); at 0.29, 0.31 and 1 all twenty sleep.
-        # A limit cycle the runtime should not have: docs/architecture.md, "Bases".
-        cls.pile_model = os.path.join(d, "pile")
-        run(MPIEXEC, "-n", "2", "--oversubscribe", BAKE, mesh, *material, "--pca-amplitude", 1, "-o", cls.pile_model)
         cls.pinned = os.path.join(d, "pinned")
         run(BAKE, mesh, "--fix", "x<min+1e-9", *material, "--no-fidelity", "-o", cls.pinned)
 
@@ -147,16 +141,18 @@ class FreeFlight(unittest.TestCase):
 
     def test_a_pile_of_twenty_comes_to_rest(self):
         walls = ["box:0,0.95,0.1,1,0.05,0.1", "box:0,-0.95,0.1,1,0.05,0.1", "box:0.95,0,0.1,0.05,1,0.1", "box:-0.95,0,0.1,0.05,1,0.1"]
-        pile = lambda *more: json.loads(run(QUIVER, "sim", self.pile_model + ".qvr", "--free", "--gravity", "--pile", 20,
+        pile = lambda *more: json.loads(run(QUIVER, "sim", self.free + ".qvr", "--free", "--gravity", "--pile", 20,
                                             "--position", "0,0,0.2", "--collider", "plane:0,0,1,0",
-                                            *[a for w in walls for a in ("--collider", w)], "--alpha", 5, "--steps", 360,
+                                            *[a for w in walls for a in ("--collider", w)], "--alpha", 5, "--steps", 480,
                                             "--hold", 0, "--json", *more).stdout)
-        # Kept awake, it comes to rest by itself; by default it falls asleep there.
+        # Kept awake, it comes to rest by itself; by default it falls asleep there. 8 s: the bars the
+        # bake makes (basis 2) had a late slip at 5.5 s and all slept at 6.5 s, within 6 s at
+        # --pca-amplitude 0.29, 0.31 or 1 (2026-11-29).
         j, sleeping = pile("--sleep-speed", 0), pile()
         self.assertEqual((j["asleep_at_end"], sleeping["asleep_at_end"]), (0, 20))
         self.assertLess(np.abs(np.array(j["final_centers"]) - np.array(sleeping["final_centers"])).max(), 0.002)
         heights = sorted(c[2] for c in j["final_centers"])
-        print(f"pile of {j['bodies']}: fastest {j['max_final_speed_mps']:.2g} m/s after 6 s, centres {heights[0]:.3f} to "
+        print(f"pile of {j['bodies']}: fastest {j['max_final_speed_mps']:.2g} m/s after 8 s, centres {heights[0]:.3f} to "
               f"{heights[-1]:.3f} m high, deepest {j['max_penetration_m'] * 1000:.2g} mm, {j['step_us_median']:.0f} us a step")
         self.assertEqual(j["bodies"], 20)
         self.assertEqual(j["resets"], 0)
