@@ -1,5 +1,6 @@
 #include "common/rigid_body.h"
 
+#include <cmath>
 #include <stdexcept>
 
 #include <Eigen/SparseCore>
@@ -7,6 +8,29 @@
 #include "common/mass_matrix.h"
 
 namespace quiver {
+
+RestMoments restMoments(const TetMesh& mesh, const std::vector<Material>& perTet) {
+  if (static_cast<int>(perTet.size()) != mesh.tetCount())
+    throw std::invalid_argument("rest moments: need one material per tet");
+  RestMoments out;
+  for (int t = 0; t < mesh.tetCount(); ++t) {
+    const double m = perTet[t].density * std::abs(signedVolume6(mesh, t)) / 6;
+    for (int i : mesh.tets[t]) out.centre += 0.25 * m * mesh.vertices[i];
+    out.mass += m;
+  }
+  out.centre /= out.mass;
+  // Per tet, for y linear with corner values y_i: \int y y^T = V / 20 (sum y_i y_i^T + sum y_i (sum y_i)^T).
+  for (int t = 0; t < mesh.tetCount(); ++t) {
+    Eigen::Matrix3d squares = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int i : mesh.tets[t]) {
+      const Eigen::Vector3d y = mesh.vertices[i] - out.centre;
+      squares += y * y.transpose(), sum += y;
+    }
+    out.secondMoment += perTet[t].density * std::abs(signedVolume6(mesh, t)) / 6 / 20 * (squares + sum * sum.transpose());
+  }
+  return out;
+}
 
 RigidBodyMoments rigidBodyMoments(const TetMesh& mesh, const std::vector<Material>& perTet,
                                   const Eigen::MatrixXd& basis) {
@@ -21,16 +45,14 @@ RigidBodyMoments rigidBodyMoments(const TetMesh& mesh, const std::vector<Materia
   Eigen::SparseMatrix<double> Ms(n, n);
   Ms.setFromTriplets(entries.begin(), entries.end());
 
+  const RestMoments rest = restMoments(mesh, perTet);
   RigidBodyMoments out;
+  out.mass = rest.mass;
+  out.centre = rest.centre;
+  out.secondMoment = rest.secondMoment;
   Eigen::MatrixXd X(n, 3);
-  for (int v = 0; v < n; ++v) X.row(v) = mesh.vertices[v].transpose();
-  const Eigen::VectorXd weights = Ms * Eigen::VectorXd::Ones(n);  // row sums: the lumped masses
-  out.mass = weights.sum();
-  out.centre = X.transpose() * weights / out.mass;
-  X.rowwise() -= out.centre.transpose();
+  for (int v = 0; v < n; ++v) X.row(v) = (mesh.vertices[v] - out.centre).transpose();
   const Eigen::MatrixXd MsX = Ms * X;
-  const Eigen::Matrix3d S = X.transpose() * MsX;
-  out.secondMoment = 0.5 * (S + S.transpose());  // symmetric to the bit, as the .qvr requires
   const Eigen::Index r = basis.cols();
   std::vector<Eigen::MatrixXd> component(3), massComponent(3);  // U_a (n x r) and Ms U_a
   for (int a = 0; a < 3; ++a) {

@@ -18,6 +18,15 @@
 
 namespace quiver {
 
+// The rest shape's m, c and S0 alone: summed tet by tet, cheap at any mesh size. Throws
+// std::invalid_argument unless there is one material per tet.
+struct RestMoments {
+  double mass = 0;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d secondMoment = Eigen::Matrix3d::Zero();  // S0, symmetric to the bit
+};
+RestMoments restMoments(const TetMesh& mesh, const std::vector<Material>& perTet);
+
 struct RigidBodyMoments {
   double mass = 0;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();

@@ -8,6 +8,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
+#include "common/rigid_body.h"
 #include "formats/npy.h"
 #include "precompute/checkpoint.h"
 #include "precompute/input_hash.h"
@@ -130,26 +131,7 @@ Eigen::MatrixXd modesThenDerivatives(Mat mass, const DofLayout& layout, const Li
 } // namespace
 
 double objectExtent(const TetMesh& mesh, const std::vector<Material>& perTet) {
-  double mass = 0;
-  Eigen::Vector3d first = Eigen::Vector3d::Zero();
-  for (int t = 0; t < mesh.tetCount(); ++t) {
-    const double m = perTet[t].density * std::abs(signedVolume6(mesh, t)) / 6;
-    for (int i : mesh.tets[t]) first += 0.25 * m * mesh.vertices[i];
-    mass += m;
-  }
-  const Eigen::Vector3d c = first / mass;
-  // Per tet, for y linear with corner values y_i: \int |y|^2 = V / 20 (sum |y_i|^2 + |sum y_i|^2).
-  double second = 0;
-  for (int t = 0; t < mesh.tetCount(); ++t) {
-    double squares = 0;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (int i : mesh.tets[t]) {
-      const Eigen::Vector3d y = mesh.vertices[i] - c;
-      squares += y.squaredNorm(), sum += y;
-    }
-    second += perTet[t].density * std::abs(signedVolume6(mesh, t)) / 6 / 20 * (squares + sum.squaredNorm());
-  }
-  return std::sqrt(second);
+  return std::sqrt(restMoments(mesh, perTet).secondMoment.trace());
 }
 
 ReducedBasis buildBasis(Mat mass, const DofLayout& layout, const LinearModes& modes,

@@ -5,9 +5,11 @@
 #include <stdexcept>
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCore>
 #include <gtest/gtest.h>
 
 #include "common/box_mesh.h"
+#include "common/mass_matrix.h"
 
 namespace quiver {
 namespace {
@@ -79,6 +81,40 @@ TEST(RigidBodyMoments, ATranslationHasNoFirstMomentAndTheWholeMass) {
   EXPECT_NEAR(rb.second[3 * 1 + 1](0, 0), rb.mass, 1e-12 * rb.mass);
   EXPECT_EQ(rb.second[0](0, 0), 0.0);
   EXPECT_THROW(rigidBodyMoments(mesh, uniform(mesh), Eigen::MatrixXd(5, 1)), std::invalid_argument);
+  EXPECT_THROW(restMoments(mesh, std::vector<Material>(3)), std::invalid_argument);
+}
+
+// The rest moments, summed tet by tet, are the consistent mass's: its row sums weigh the centre and
+// X^T M X is S0 (to rounding), and S0 is symmetric to the bit, as a .qvr's RIGID_BODY must be.
+TEST(RigidBodyMoments, RestMomentsAreTheConsistentMassMoments) {
+  const TetMesh mesh = makeBoxMesh(kSize, {3, 2, 4});
+  TetMesh skewed = mesh;
+  for (Eigen::Vector3d& x : skewed.vertices) x += Eigen::Vector3d(0.3 * x.y() * x.z(), 0.1 * x.x() * x.x(), 0.05 * x.y());
+  std::vector<Material> materials = uniform(skewed);
+  for (size_t t = 0; t < materials.size(); ++t) materials[t].density *= 1 + 0.1 * static_cast<double>(t % 7);
+  const RestMoments rest = restMoments(skewed, materials);
+  const Eigen::SparseMatrix<double> M = consistentMassMatrix(skewed, materials);
+  Eigen::MatrixXd X(3 * skewed.vertexCount(), 3);
+  X.setZero();
+  for (int v = 0; v < skewed.vertexCount(); ++v)
+    for (int a = 0; a < 3; ++a) X(3 * v + a, a) = 1;  // translations
+  const Eigen::MatrixXd MX = M * X;
+  double mass = 0;
+  Eigen::Vector3d first = Eigen::Vector3d::Zero();
+  for (int v = 0; v < skewed.vertexCount(); ++v) {
+    mass += MX(3 * v, 0);
+    first += MX(3 * v, 0) * skewed.vertices[v];
+  }
+  const Eigen::Vector3d centre = first / mass;
+  Eigen::MatrixXd Y(3 * skewed.vertexCount(), 3);  // columns: (X - c)_a, one per component
+  Y.setZero();
+  for (int v = 0; v < skewed.vertexCount(); ++v)
+    for (int a = 0; a < 3; ++a) Y(3 * v, a) = skewed.vertices[v](a) - centre(a);
+  const Eigen::Matrix3d S = Y.transpose() * (M * Y);
+  EXPECT_NEAR(rest.mass, mass, 1e-13 * mass);
+  EXPECT_LT((rest.centre - centre).norm(), 1e-14);
+  EXPECT_LT((rest.secondMoment - S).norm(), 1e-13 * S.norm());
+  EXPECT_EQ(rest.secondMoment, rest.secondMoment.transpose());
 }
 
 } // namespace
