@@ -8,7 +8,7 @@ each, every run with this core's FMA peak measured in it. Prints the CPU and BLA
 benchmark's median and fastest run for both and the median's ratio.
 
     /usr/bin/python3 bench/ab.py --base 811b657 [--build build/release] [--r 30] [--runs 8] [--seconds 1]
-        [--filter 'ManyObjects/.*/together|EvaluateGroup/r']
+        [--filter 'ManyObjects/.*/together|EvaluateGroup/r'] [--flying (and the beam baked free: --filter Flying/)]
 """
 import argparse
 import json
@@ -54,16 +54,19 @@ def main():
     ap.add_argument("--runs", type=int, default=8)
     ap.add_argument("--seconds", type=float, default=1.0, help="each benchmark's time in each run")
     ap.add_argument("--filter", default="ManyObjects/.*/together|EvaluateGroup/r")
+    ap.add_argument("--flying", action="store_true", help="also bake the beam free, for the Flying/ benchmarks")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         base = args.base if os.path.isfile(args.base) else build_base(args.base, tmp)
         binaries = {"base": base, "new": os.path.join(args.build, "bench", "bench_runtime")}
-        model = bake_beams(os.path.join(args.build, "apps"), tmp, [args.r])[0]
+        models = bake_beams(os.path.join(args.build, "apps"), tmp, [args.r])
+        if args.flying:
+            models += [f"--flying={m}" for m in bake_beams(os.path.join(args.build, "apps"), tmp, [args.r], free=True)]
         times, peaks = {}, {"base": [], "new": []}
         for run in range(args.runs):
             for side in ("base", "new") if run % 2 == 0 else ("new", "base"):
                 binary = binaries[side]
-                out = subprocess.run([binary, model, f"--benchmark_filter=PeakFma|{args.filter}", "--benchmark_format=json",
+                out = subprocess.run([binary, *models, f"--benchmark_filter=PeakFma|{args.filter}", "--benchmark_format=json",
                                       f"--benchmark_min_time={args.seconds}"], check=True, capture_output=True, text=True).stdout
                 for b in json.loads(out)["benchmarks"]:
                     if b["name"] == "PeakFma":

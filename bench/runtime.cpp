@@ -2,14 +2,15 @@
 //   Evaluate/force, Evaluate/force+stiffness (float64 and float32 coefficients), EvaluateGroup
 //   (sixteen states at once, as qv_instances_step evaluates them; both precisions), Step/newton
 //   (implicit Newmark, Barbic & James's one Newton iteration; both precisions), Step/minimize (the
-//   default solver), both under a load that keeps the object moving, and ManyObjects: 1000
+//   default solver), both under a load that keeps the object moving, Flying/step (a free model's
+//   instance in flight, spun and pushed, given as --flying=MODEL.qvr), and ManyObjects: 1000
 //   instances of one model stepped per frame (both solvers, one by one and in one
 //   qv_instances_step call).
 // Measured in the same run, as yardsticks: this core's peak FMA throughput (PeakFma) and a plain
 // read of as many bytes as one evaluation streams (Stream/f64, Stream/f32: the floor set by
 // wherever those bytes sit). Each benchmark's label carries a hash of its final state.
 //   bench/runtime.py --build build/release     (bakes the models, runs this, prints the table)
-//   build/release/bench/bench_runtime MODEL.qvr [MODEL.qvr ...] [--benchmark_* flags]
+//   build/release/bench/bench_runtime MODEL.qvr [MODEL.qvr ...] [--flying=FREE.qvr] [--benchmark_* flags]
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -233,6 +234,38 @@ void Step(benchmark::State& state, const char* path, qv_solver solver, int preci
   qv_model_destroy(m.model);
 }
 
+// A free model's instance pushed on one corner vertex (0.1 times its weight, flipping every quarter
+// second). In flight (config.free_flight), spun at (0, 3, 10) rad/s, the frame turns, tumbles and
+// deforms: the step with its rigid frame (rigid_frame.h), the centrifugal potential in every
+// evaluation. Unmoved: the same push on the model without flight (its frame stays put).
+void FlyingStep(benchmark::State& state, const char* path, bool flying) {
+  Loaded m(path);
+  qv_instance_config config;
+  qv_instance_config_init(&config, m.model);
+  config.free_flight = flying;
+  qv_instance* s = nullptr;
+  qv_instance_create(m.model, &config, nullptr, &s);
+  const qv_rigid_state spin = {{0, 0, 0}, {1, 0, 0, 0}, {0, 0, 0}, {0, 3, 10}};
+  if (flying) qv_instance_set_rigid_state(s, &spin);
+  const double push = 0.1 * QV_STANDARD_GRAVITY * m.info.total_mass;
+  long steps = 0, iterations = 0, resets = 0;
+  for (auto _ : state) {
+    const double force[3] = {0, 0, (steps / 15) % 2 ? push : -push};
+    qv_instance_add_vertex_force(s, 0, force);
+    resets += qv_instance_step(s) == QV_STEP_RESET;
+    qv_step_report report;
+    qv_instance_last_step(s, &report);
+    iterations += report.newton_iterations;
+    ++steps;
+  }
+  state.counters["r"] = m.info.r;
+  state.counters["newton_per_step"] = static_cast<double>(iterations) / static_cast<double>(steps);
+  state.counters["resets"] = static_cast<double>(resets);  // expected 0: a reset step is no measure
+  state.SetLabel("state " + stateHash(s, m.info.r));
+  qv_instance_destroy(s);
+  qv_model_destroy(m.model);
+}
+
 // `objects` instances of one model per frame, each under its own push on the first coordinate (0.1
 // to 0.2 times what gravity puts there, flipping every quarter second, out of phase from one
 // instance to the next: the load of Step, spread), stepped one by one (qv_instance_step) or in one call
@@ -289,6 +322,14 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark("PeakFma", PeakFma, 4);
   for (int i = 1; i < argc; ++i) {
     const char* path = argv[i];
+    if (std::strncmp(path, "--flying=", 9) == 0) {  // a free model: its step in flight and without
+      Loaded probe(path + 9);
+      const std::string r = "/r" + std::to_string(probe.info.r);
+      qv_model_destroy(probe.model);
+      benchmark::RegisterBenchmark(("Flying/step" + r).c_str(), FlyingStep, path + 9, true)->Unit(benchmark::kMicrosecond);
+      benchmark::RegisterBenchmark(("Flying/unmoved" + r).c_str(), FlyingStep, path + 9, false)->Unit(benchmark::kMicrosecond);
+      continue;
+    }
     Loaded probe(path);
     const std::string r = "/r" + std::to_string(probe.info.r);
     qv_model_destroy(probe.model);

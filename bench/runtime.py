@@ -3,8 +3,9 @@
 a plain read of the bytes one evaluation streams, and against Vega FEM's way of stepping
 (../shared/tools/vega_like_step.cpp, compiled here at bench time with -O3 -march=native, never copied
 into the project), all measured in the same run on the same CPU. Bakes a 1 x 0.1 x 0.1 cantilever
-(40 x 4 x 4 cells) at each r, runs bench_runtime on the models, prints the CPU, the BLAS core the
-bake's OpenBLAS picks, and markdown tables (the ones in bench/README.md).
+(40 x 4 x 4 cells) at each r, runs bench_runtime on the models (and on the beam baked free at r = 20 and 30: the
+step in flight), prints the CPU, the BLAS core the bake's OpenBLAS picks, and markdown tables (the
+ones in bench/README.md).
 
     /usr/bin/python3 bench/runtime.py --build build/release [--shared ../shared]
 """
@@ -19,6 +20,7 @@ import tempfile
 from machine import machine_line
 
 RANKS = (10, 20, 30, 40, 60)
+FLYING = (20, 30)  # the free beam's r for the flying step
 
 
 def vega_steps(shared, tmp, repetitions):
@@ -39,18 +41,20 @@ def vega_steps(shared, tmp, repetitions):
     return steps
 
 
-def bake_beams(apps, tmp, basis_sizes):
-    """The 1 x 0.1 x 0.1 cantilever (40 x 4 x 4 cells) baked at each r of basis_sizes on 2 ranks: the .qvr paths."""
+def bake_beams(apps, tmp, basis_sizes, free=False):
+    """The 1 x 0.1 x 0.1 cantilever (40 x 4 x 4 cells) baked at each r of basis_sizes on 2 ranks: the .qvr paths.
+    free: the same beam with no fixed vertex (a model that can fly)."""
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_pml="ob1")
     mesh = os.path.join(tmp, "beam.vtu")
-    subprocess.run([os.path.join(apps, "quiver-mesh"), "beam", "--size", "1,0.1,0.1", "--cells", "40,4,4", "-o", mesh],
-                   check=True)
+    if not os.path.exists(mesh):
+        subprocess.run([os.path.join(apps, "quiver-mesh"), "beam", "--size", "1,0.1,0.1", "--cells", "40,4,4", "-o", mesh],
+                       check=True)
     models = []
     for r in basis_sizes:
-        name = os.path.join(tmp, f"r{r}")
-        subprocess.run(["mpirun", "-n", "2", os.path.join(apps, "quiver-bake"), mesh, "--fix", "x<min+1e-9",
-                        "--modes", "12", "--rank", str(r), "--quiet", "-o", name], check=True, env=env,
-                       stdin=subprocess.DEVNULL)
+        name = os.path.join(tmp, f"{'free' if free else 'r'}{r}")
+        subprocess.run(["mpirun", "-n", "2", os.path.join(apps, "quiver-bake"), mesh,
+                        *([] if free else ["--fix", "x<min+1e-9"]), "--modes", "12", "--rank", str(r), "--quiet",
+                        "-o", name], check=True, env=env, stdin=subprocess.DEVNULL)
         models.append(name + ".qvr")
     return models
 
@@ -69,7 +73,8 @@ def main():
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         models = bake_beams(os.path.join(args.build, "apps"), tmp, RANKS)
-        out = subprocess.run([os.path.join(args.build, "bench", "bench_runtime"), *models, "--benchmark_format=json",
+        flying = [f"--flying={m}" for m in bake_beams(os.path.join(args.build, "apps"), tmp, FLYING, free=True)]
+        out = subprocess.run([os.path.join(args.build, "bench", "bench_runtime"), *models, *flying, "--benchmark_format=json",
                               f"--benchmark_repetitions={args.repetitions}", "--benchmark_report_aggregates_only=true"],
                              check=True, capture_output=True, text=True).stdout
         vega = vega_steps(args.shared, tmp, args.repetitions)
@@ -126,6 +131,14 @@ def main():
                 print(f"| {r} | {solver} | {alone['real_time']:.2f} | {together['real_time']:.2f} | "
                       f"{alone['real_time'] / together['real_time']:.2f} | {int(alone['resets'] + together['resets'])} | "
                       f"{int(alone['minimized'] + together['minimized'])} |")
+
+    print("\nFree flight: the same beam baked free, one instance in flight (spun at (0, 3, 10) rad/s, pushed on a "
+          "corner), against the same push on the model without flight (bench/runtime.cpp, FlyingStep):\n")
+    heading("r", "flying step (us)", "its Newton iterations", "unmoved step (us)", "its Newton iterations", "ratio")
+    for r in FLYING:
+        fly, still = get(f"Flying/step/r{r}"), get(f"Flying/unmoved/r{r}")
+        print(f"| {r} | {fly['real_time']:.2f} | {fly['newton_per_step']:.2f} | {still['real_time']:.2f} | "
+              f"{still['newton_per_step']:.2f} | {fly['real_time'] / still['real_time']:.2f} |")
 
 
 if __name__ == "__main__":
