@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "simd_dispatch.h"
+
 namespace quiver::rt {
 
 namespace {
@@ -59,6 +61,59 @@ double dot(const double* a, const double* b, int n) {
   return s;
 }
 
+// Columns j0 .. j0 + width of the nine products M_ab^T x (below), summed over the rows k of M_ab in
+// order: nine independent running sums of `width` (a full vector), where one alone would wait on
+// the multiply-add latency at every k.
+template <size_t W>
+[[gnu::always_inline]] inline void transposedSweep(const double* M, const double* x, size_t n, size_t j0, size_t width,
+                                                   double (&sum)[9][W]) {
+  for (size_t k = 0; k < n; ++k) {
+    const double xk = x[k];
+    for (size_t ab = 0; ab < 9; ++ab) {
+      const double* row = M + (ab * n + k) * n + j0;
+      if (width == W) {
+#pragma omp simd
+        for (size_t l = 0; l < W; ++l) sum[ab][l] += row[l] * xk;
+      } else {
+        for (size_t l = 0; l < width; ++l) sum[ab][l] += row[l] * xk;
+      }
+    }
+  }
+}
+
+// out_ab = base_ab + M_ab^T x for the nine r x r row-major blocks M_ab (ab = 3a + b), base_ab of r
+// each (null: none), by the rows of M_ab, which are contiguous (a dot product per row would not
+// vectorise: its sum is ordered). W columns at a time: eight with AVX-512's 32 registers, four
+// with AVX2's 16 (nine vectors of running sums either way).
+template <size_t W>
+QV_HOT void transposedProducts(const double* base, const double* M, const double* x, int r, double* out) {
+  const size_t n = static_cast<size_t>(r);
+  for (size_t j0 = 0; j0 < n; j0 += W) {
+    const size_t width = std::min(W, n - j0);
+    double sum[9][W] = {};
+    if (width == W) {
+      transposedSweep<W>(M, x, n, j0, W, sum);
+    } else {
+      transposedSweep<W>(M, x, n, j0, width, sum);
+    }
+    for (size_t ab = 0; ab < 9; ++ab)
+      for (size_t l = 0; l < width; ++l) out[ab * n + j0 + l] = (base ? base[ab * n + j0 + l] : 0.0) + sum[ab][l];
+  }
+}
+
+void transposedProducts(const double* base, const double* M, const double* x, int r, double* out) {
+  vectorRegisters32() ? transposedProducts<8>(base, M, x, r, out) : transposedProducts<4>(base, M, x, r, out);
+}
+
+// out_i -= sum_ab W_ab X_ab[i] for nine blocks X_ab of n entries, `stride` apart: one pass over out.
+QV_HOT void subtractWeighted(const double W[9], const double* X, size_t stride, size_t n, double* out) {
+  for (size_t i = 0; i < n; ++i) {
+    double sum = 0;
+    for (int ab = 0; ab < 9; ++ab) sum += W[ab] * X[ab * stride + i];
+    out[i] -= sum;
+  }
+}
+
 } // namespace
 
 void RigidFrame::attach(double* scratch, int r) {
@@ -79,14 +134,8 @@ void RigidFrame::setOrientation(const double qn[4]) {
 void RigidFrame::refresh(const qv_model& model, const double* q, const double* qdot) {
   const int r = model.info.r;
   const Moments mo(model);
-  // y_ab = B_ab + A_ba q, A_ba = \int rho U_b U_a^T.
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) {
-      const double* Bab = mo.B + (3 * a + b) * static_cast<size_t>(r);
-      const double* Aba = mo.A + (3 * b + a) * static_cast<size_t>(r) * r;
-      double* y = moments + (3 * a + b) * static_cast<size_t>(r);
-      for (int j = 0; j < r; ++j) y[j] = Bab[j] + dot(Aba + static_cast<size_t>(j) * r, q, r);
-    }
+  // y_ab = B_ab + A_ba q = B_ab + A_ab^T q, A_ab = \int rho U_a U_b^T.
+  transposedProducts(mo.B, mo.A, q, r, moments);
   // S_ab = S0_ab + B_ba q + y_ab q; I = tr(S) 1 - S; h_c = e_cab y_ab q'.
   double S[9];
   for (int a = 0; a < 3; ++a)
@@ -140,35 +189,30 @@ double RigidFrame::addCentrifugal(const qv_model& model, const double* q, double
   const int r = model.info.r;
   const size_t rr = static_cast<size_t>(r) * r;
   const Moments mo(model);
-  // S(q) = S0 + (B_ab + B_ba) q + q^T A_ab q, keeping A_ab q for the gradient.
+  // S(q) = S0 + (B_ab + B_ba) q + q^T A_ab q; q^T A_ab q = q^T A_ba q, and A_ba q = A_ab^T q is kept
+  // (in products[ab]) for the gradient.
+  transposedProducts(nullptr, mo.A, q, r, products);
   double S[9];
   for (int ab = 0; ab < 9; ++ab) {
     const int a = ab / 3, b = ab % 3;
-    double* t = products + ab * static_cast<size_t>(r);
-    for (int j = 0; j < r; ++j) t[j] = dot(mo.A + ab * rr + static_cast<size_t>(j) * r, q, r);
     S[ab] = mo.S0[ab] + dot(mo.B + ab * static_cast<size_t>(r), q, r) + dot(mo.B + (3 * b + a) * static_cast<size_t>(r), q, r) +
-            dot(q, t, r);
+            dot(q, products + ab * static_cast<size_t>(r), r);
   }
   const double trace = S[0] + S[4] + S[8];
   double I[9], w[3];
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) I[3 * a + b] = (a == b ? trace : 0.0) - 0.5 * (S[3 * a + b] + S[3 * b + a]);
   solve3(I, heldMomentum, w);
-  // dV/dq = -omega . (dI/dq) omega / 2 = -sum_ab W_ab (B_ab + A_ab q), W_ab = |omega|^2 d_ab - omega_a omega_b;
-  // its Hessian with omega held, -sum_ab W_ab (A_ab + A_ab^T) / 2 (softening; the step shifts it).
+  // dV/dq_j = -omega . I_j omega / 2 = -sum_ab W_ab (B_ab + A_ab q)_j, I_j = dI/dq_j and
+  // W_ab = |omega|^2 d_ab - omega_a omega_b (A_ab q = products[ba], W symmetric).
   const double w2 = dot(w, w, 3);
-  for (int ab = 0; ab < 9; ++ab) {
-    const int a = ab / 3, b = ab % 3;
-    const double W = (a == b ? w2 : 0.0) - w[a] * w[b];
-    if (W == 0) continue;
-    const double* Bab = mo.B + ab * static_cast<size_t>(r);
-    const double* t = products + ab * static_cast<size_t>(r);
-    const double* A = mo.A + ab * rr;
-    for (int j = 0; j < r; ++j) {
-      resisting[j] -= W * (Bab[j] + t[j]);
-      for (int k = 0; k < r; ++k) jacobian[j * r + k] -= 0.5 * W * (A[j * r + k] + A[k * r + j]);
-    }
-  }
+  double W[9];
+  for (int ab = 0; ab < 9; ++ab) W[ab] = (ab % 4 == 0 ? w2 : 0.0) - w[ab / 3] * w[ab % 3];
+  subtractWeighted(W, mo.B, r, r, resisting);
+  subtractWeighted(W, products, r, r, resisting);
+  // Its Hessian with omega held, -sum_ab W_ab A_ab (softening; the step shifts it), symmetric as
+  // W_ab = W_ba and A_ba = A_ab^T (to rounding: the factorisations read its upper triangle).
+  subtractWeighted(W, mo.A, rr, rr, jacobian);
   return 0.5 * dot(heldMomentum, w, 3);
 }
 
