@@ -49,12 +49,12 @@ struct RigidFrame {
   double homePosition[3] = {};     // where a reset puts the frame (the last set state), at rest
   double homeOrientation[4] = {1, 0, 0, 0};
   double* moments = nullptr;       // 9 x r: y_ab = \int rho p_a U_b at the current state
-  double* products = nullptr;      // 9 x r: A_ab^T q at the centrifugal potential's trial q
+  double* products = nullptr;      // 9 x r: A_ab^T q at the centrifugal potential's trial q; then 6 x r its Hessian's
   double heldMomentum[3] = {};     // L_b = R^T L - h, body frame, held over a step (holdSpin())
   double heldAngularMomentum[3] = {};  // L when it was held (spinChangedSinceHold())
   double turnCredit = 0;           // J the turns took from the centrifugal potential, which later turns may give back
 
-  static size_t scratchDoubles(int r) { return 18 * static_cast<size_t>(r); }
+  static size_t scratchDoubles(int r) { return 24 * static_cast<size_t>(r); }
   // Takes its scratch from `scratch` (scratchDoubles(r) doubles).
   void attach(double* scratch, int r);
   void setOrientation(const double quaternion[4]);  // normalises, updates `rotation`
@@ -77,7 +77,7 @@ struct RigidFrame {
            angularMomentum[2] != heldAngularMomentum[2];
   }
   // The centrifugal potential V(q) = L_b . I(q)^-1 L_b / 2: adds its gradient to `resisting` (the
-  // resisting sign of loads.h) and its Gauss-Newton Hessian (omega held) to `jacobian`; returns V.
+  // resisting sign of loads.h) and its Hessian to `jacobian`; returns V.
   double addCentrifugal(const qv_model& model, const double* q, double* resisting, double* jacobian) const;
   // The frame's share of the step: momenta by this step's force, torque and gravity (accelerate),
   // then x and R (move); contact impulses go between the two.
