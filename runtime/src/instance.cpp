@@ -302,19 +302,17 @@ void qv_instance::takeOutTurnExcess() {
     frame.turnCredit = 0;
     return;
   }
-  double excess = frame.turnExcess(*model, q, v);
-  if (!(excess > 0)) {
-    if (excess < 0) frame.turnCredit -= excess;
+  // A negative credit is a debt: what q' could not give when the turns added more than it held.
+  const double owed = frame.turnExcess(*model, q, v) - frame.turnCredit;
+  if (!(owed > 0)) {
+    if (owed < 0) frame.turnCredit = -owed;
     return;
   }
-  const double covered = std::fmin(frame.turnCredit, excess);
-  frame.turnCredit -= covered;
-  excess -= covered;
-  if (!(excess > 0)) return;
   double kinetic = 0;
   for (int i = 0; i < r; ++i) kinetic += 0.5 * v[i] * v[i];
-  const double keep = kinetic > excess ? std::sqrt((kinetic - excess) / kinetic) : 0.0;
+  const double keep = kinetic > owed ? std::sqrt((kinetic - owed) / kinetic) : 0.0;
   for (int i = 0; i < r; ++i) v[i] *= keep;
+  frame.turnCredit = -std::fmax(owed - kinetic, 0.0);
   lastStep.energy_removed += kinetic * (1 - keep * keep);
 }
 
@@ -428,7 +426,7 @@ bool qv_instance::restoreSnapshot(const double* in) {
     frame.setOrientation(f + 3);
     std::memcpy(frame.velocity, f + 7, 3 * sizeof(double));
     std::memcpy(frame.angularMomentum, f + 10, 3 * sizeof(double));
-    frame.turnCredit = std::fmax(f[13], 0.0);
+    frame.turnCredit = std::isfinite(f[13]) ? f[13] : 0.0;
   }
   return true;
 }

@@ -52,7 +52,7 @@ struct RigidFrame {
   double* products = nullptr;      // 9 x r: A_ab^T q at the centrifugal potential's trial q; then 6 x r its Hessian's
   double heldMomentum[3] = {};     // L_b = R^T L - h, body frame, held over a step (holdSpin())
   double heldAngularMomentum[3] = {};  // L when it was held (spinChangedSinceHold())
-  double turnCredit = 0;           // J the turns took from the centrifugal potential, which later turns may give back
+  double turnCredit = 0;           // J the turns took from the centrifugal potential, which later turns may give back; < 0: owed
 
   static size_t scratchDoubles(int r) { return 24 * static_cast<size_t>(r); }
   // Takes its scratch from `scratch` (scratchDoubles(r) doubles).

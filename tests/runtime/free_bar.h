@@ -2,6 +2,7 @@
 // A free 0.6 x 0.1 x 0.1 bar (tests/support/small_model.h, free), loaded from memory, with the mesh's
 // consistent mass to measure what the runtime hands out: centre of mass, momentum.
 #include <array>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -9,7 +10,9 @@
 #include <Eigen/SparseCore>
 #include <gtest/gtest.h>
 
+#include "common/box_mesh.h"
 #include "common/mass_matrix.h"
+#include "common/rigid_body.h"
 #include "formats/model/qvr_writer.h"
 #include "quiver/quiver.h"
 #include "tests/support/small_model.h"
@@ -23,7 +26,10 @@ struct FreeBar {
   qv_model_info info{};
   Eigen::SparseMatrix<double> mass;  // n x n, the consistent mass's x-x block
 
-  explicit FreeBar(int rank = 10, std::array<int, 3> cells = {6, 1, 1}, Eigen::Vector3d size = {0.6, 0.1, 0.1}) {
+  // derivativeAmplitude: SmallModelSpec's (1, the suite's bases), or bakesAmplitude() for the basis
+  // quiver-bake makes of this bar by default.
+  explicit FreeBar(int rank = 10, std::array<int, 3> cells = {6, 1, 1}, Eigen::Vector3d size = {0.6, 0.1, 0.1},
+                   double derivativeAmplitude = 1) {
     test::SmallModelSpec spec;
     spec.size = size;
     spec.cells = cells;
@@ -31,6 +37,7 @@ struct FreeBar {
     spec.rank = rank;
     spec.youngsModulus = kE;
     spec.density = kRho;
+    spec.derivativeAmplitude = derivativeAmplitude;
     const ModelContents contents = test::smallBeamModel(spec);
     const std::string bytes = formatModel(contents);
     char message[512] = "";
@@ -54,6 +61,15 @@ struct FreeBar {
     mass.setFromTriplets(entries.begin(), entries.end());
   }
   ~FreeBar() { qv_model_destroy(model); }
+
+  // The bake's default weighting of the derivatives (--pca-amplitude 0.3 times the extent
+  // ||X - c||_M, precompute/stages/basis.h) for the default bar: 0.13.
+  static double bakesAmplitude() {
+    Material m;
+    m.density = kRho;
+    const TetMesh box = makeBoxMesh({0.6, 0.1, 0.1}, {6, 1, 1});
+    return 0.3 * std::sqrt(restMoments(box, std::vector<Material>(box.tetCount(), m)).secondMoment.trace());
+  }
 
   qv_instance_config config(double h) const {
     qv_instance_config c;
