@@ -41,6 +41,16 @@ void solve3(const double S[9], const double b[3], double x[3]) {
   x[2] = (c02 * b[0] + c12 * b[1] + c22 * b[2]) / det;
 }
 
+// S^-1 (row-major, symmetric) of a symmetric positive definite 3 x 3 S, column by column.
+void inverse3(const double S[9], double out[9]) {
+  for (int c = 0; c < 3; ++c) {
+    const double e[3] = {c == 0 ? 1.0 : 0.0, c == 1 ? 1.0 : 0.0, c == 2 ? 1.0 : 0.0};
+    double column[3];
+    solve3(S, e, column);
+    for (int a = 0; a < 3; ++a) out[3 * a + c] = column[a];
+  }
+}
+
 void cross(const double a[3], const double b[3], double out[3]) {
   out[0] = a[1] * b[2] - a[2] * b[1], out[1] = a[2] * b[0] - a[0] * b[2], out[2] = a[0] * b[1] - a[1] * b[0];
 }
@@ -228,12 +238,7 @@ double RigidFrame::addCentrifugal(const qv_model& model, const double* q, double
   // triangle).
   subtractWeighted(W, mo.A, rr, rr, jacobian);
   double inverse[9];
-  for (int c = 0; c < 3; ++c) {
-    const double e[3] = {c == 0 ? 1.0 : 0.0, c == 1 ? 1.0 : 0.0, c == 2 ? 1.0 : 0.0};
-    double column[3];
-    solve3(I, e, column);
-    for (int a = 0; a < 3; ++a) inverse[3 * a + c] = column[a];
-  }
+  inverse3(I, inverse);
   double* g = products + 9 * static_cast<size_t>(r);  // 3 x r: g_j by component
   double* z = g + 3 * static_cast<size_t>(r);          // 3 x r: I^-1 g_j
   for (int j = 0; j < r; ++j) {
@@ -245,7 +250,10 @@ double RigidFrame::addCentrifugal(const qv_model& model, const double* q, double
     }
     const double traceJ = Sj[0] + Sj[4] + Sj[8];
     for (int a = 0; a < 3; ++a) gj[a] = traceJ * w[a] - dot(Sj + 3 * a, w, 3);
-    for (int a = 0; a < 3; ++a) g[a * static_cast<size_t>(r) + j] = gj[a], z[a * static_cast<size_t>(r) + j] = dot(inverse + 3 * a, gj, 3);
+    for (int a = 0; a < 3; ++a) {
+      g[a * static_cast<size_t>(r) + j] = gj[a];
+      z[a * static_cast<size_t>(r) + j] = dot(inverse + 3 * a, gj, 3);
+    }
   }
   addRank3(g, z, r, jacobian);
   return 0.5 * dot(heldMomentum, w, 3);
@@ -269,13 +277,8 @@ void RigidFrame::move(double h) {
   // The midpoint orientation found by fixed-point iterations instead diverged past about 0.8 rad a
   // step: a bar spun at 100 rad/s in 1/60 s steps had its momentum thrown toward its long axis, and
   // its energy grew 560-fold in 20 s (FreeFlight.FastSpinsNeverGainEnergy).
-  double inverse[9];  // I^-1, row-major (symmetric)
-  for (int k = 0; k < 3; ++k) {
-    const double e[3] = {k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0};
-    double column[3];
-    solve3(inertia, e, column);
-    for (int a = 0; a < 3; ++a) inverse[3 * a + k] = column[a];
-  }
+  double inverse[9];  // I^-1
+  inverse3(inertia, inverse);
   // (NaN: 1000, and the step resets.)
   const int substeps = std::max(1, static_cast<int>(std::fmin(std::ceil(h * std::sqrt(dot(bodyOmega, bodyOmega, 3)) / 0.5), 1000.0)));
   const double dt = h / substeps;
