@@ -8,7 +8,7 @@ each, every run with this core's FMA peak measured in it. Prints the CPU and BLA
 benchmark's median and fastest run for both and the median's ratio.
 
     /usr/bin/python3 bench/ab.py --base 811b657 [--build build/release] [--r 30] [--runs 8] [--seconds 1]
-        [--filter 'ManyObjects/.*/together|EvaluateGroup/r'] [--flying (and the beam baked free: --filter Flying/)]
+        [--filter 'ManyObjects/.*/together|EvaluateGroup/r'] [--flying (and the Flying/ benchmarks)]
 """
 import argparse
 import json
@@ -54,13 +54,15 @@ def main():
     ap.add_argument("--runs", type=int, default=8)
     ap.add_argument("--seconds", type=float, default=1.0, help="each benchmark's time in each run")
     ap.add_argument("--filter", default="ManyObjects/.*/together|EvaluateGroup/r")
-    ap.add_argument("--flying", action="store_true", help="also bake the beam free, for the Flying/ benchmarks")
+    ap.add_argument("--flying", action="store_true",
+                    help="also bake the beam free and time the Flying/ benchmarks (the base must have them: since 54c748e)")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         base = args.base if os.path.isfile(args.base) else build_base(args.base, tmp)
         binaries = {"base": base, "new": os.path.join(args.build, "bench", "bench_runtime")}
         models = bake_beams(os.path.join(args.build, "apps"), tmp, [args.r])
         if args.flying:
+            args.filter += "|Flying/"
             models += [f"--flying={m}" for m in bake_beams(os.path.join(args.build, "apps"), tmp, [args.r], free=True)]
         times, peaks = {}, {"base": [], "new": []}
         for run in range(args.runs):

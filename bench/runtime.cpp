@@ -237,7 +237,9 @@ void Step(benchmark::State& state, const char* path, qv_solver solver, int preci
 // A free model's instance pushed on one corner vertex (0.1 times its weight, flipping every quarter
 // second). In flight (config.free_flight), spun at (0, 3, 10) rad/s, the frame turns, tumbles and
 // deforms: the step with its rigid frame (rigid_frame.h), the centrifugal potential in every
-// evaluation. Unmoved: the same push on the model without flight (its frame stays put).
+// evaluation. The push's torque changes the spin at every step, so the turns' settlement
+// (qv_instance::takeOutTurnExcess, a second refresh) does not run here. Unmoved: the same push on
+// the model without flight (its frame stays put).
 void FlyingStep(benchmark::State& state, const char* path, bool flying) {
   Loaded m(path);
   qv_instance_config config;

@@ -3,9 +3,9 @@
 a plain read of the bytes one evaluation streams, and against Vega FEM's way of stepping
 (../shared/tools/vega_like_step.cpp, compiled here at bench time with -O3 -march=native, never copied
 into the project), all measured in the same run on the same CPU. Bakes a 1 x 0.1 x 0.1 cantilever
-(40 x 4 x 4 cells) at each r, runs bench_runtime on the models (and on the beam baked free at r = 20 and 30: the
-step in flight), prints the CPU, the BLAS core the bake's OpenBLAS picks, and markdown tables (the
-ones in bench/README.md).
+(40 x 4 x 4 cells) at each r, runs bench_runtime on the models (and on the beam baked free at
+r = 20 and 30: the step in flight), prints the CPU, the BLAS core the bake's OpenBLAS picks, and
+markdown tables (the ones in bench/README.md).
 
     /usr/bin/python3 bench/runtime.py --build build/release [--shared ../shared]
 """
@@ -134,11 +134,16 @@ def main():
 
     print("\nFree flight: the same beam baked free, one instance in flight (spun at (0, 3, 10) rad/s, pushed on a "
           "corner), against the same push on the model without flight (bench/runtime.cpp, FlyingStep):\n")
-    heading("r", "flying step (us)", "its Newton iterations", "unmoved step (us)", "its Newton iterations", "ratio")
+    heading("r", "flying step (us)", "its Newton iterations", "unmoved step (us)", "its Newton iterations", "ratio",
+            "resets")
     for r in FLYING:
         fly, still = get(f"Flying/step/r{r}"), get(f"Flying/unmoved/r{r}")
+        if not (fly and still):
+            print(f"| {r} | (not measured) |")
+            continue
         print(f"| {r} | {fly['real_time']:.2f} | {fly['newton_per_step']:.2f} | {still['real_time']:.2f} | "
-              f"{still['newton_per_step']:.2f} | {fly['real_time'] / still['real_time']:.2f} |")
+              f"{still['newton_per_step']:.2f} | {fly['real_time'] / still['real_time']:.2f} | "
+              f"{int(fly['resets'] + still['resets'])} |")
 
 
 if __name__ == "__main__":

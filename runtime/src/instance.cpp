@@ -305,14 +305,15 @@ void qv_instance::takeOutTurnExcess() {
   // A negative credit is a debt: what q' could not give when the turns added more than it held.
   const double owed = frame.turnExcess(*model, q, v) - frame.turnCredit;
   if (!(owed > 0)) {
-    if (owed < 0) frame.turnCredit = -owed;
+    if (owed <= 0) frame.turnCredit = -owed;  // NaN: kept (the step resets)
     return;
   }
   double kinetic = 0;
   for (int i = 0; i < r; ++i) kinetic += 0.5 * v[i] * v[i];
   const double keep = kinetic > owed ? std::sqrt((kinetic - owed) / kinetic) : 0.0;
   for (int i = 0; i < r; ++i) v[i] *= keep;
-  frame.turnCredit = -std::fmax(owed - kinetic, 0.0);
+  const double debt = owed - kinetic;  // infinite only from a crafted snapshot's credit
+  frame.turnCredit = debt > 0 && std::isfinite(debt) ? -debt : 0.0;
   lastStep.energy_removed += kinetic * (1 - keep * keep);
 }
 
@@ -336,6 +337,7 @@ void qv_instance::setState(const double* newQ, const double* newV, const double*
   if (newQ || newAccount)
     elasticEnergyAtState = quiver::rt::elasticEnergy(*model, config.elasticity, q, work.polynomialScratch);
   if (newQ) quiver::rt::dampAt(*this, q, true, dampingStiffness);  // K(q) just evaluated
+  if (newQ || newV) frame.turnCredit = 0;  // a new state owes and is owed nothing
   if (newA) {
     std::memcpy(a, newA, sizeof(double) * r);
   } else if (consistentA) {
@@ -426,7 +428,7 @@ bool qv_instance::restoreSnapshot(const double* in) {
     frame.setOrientation(f + 3);
     std::memcpy(frame.velocity, f + 7, 3 * sizeof(double));
     std::memcpy(frame.angularMomentum, f + 10, 3 * sizeof(double));
-    frame.turnCredit = std::isfinite(f[13]) ? f[13] : 0.0;
+    frame.turnCredit = f[13];  // finite, as checked above; negative: a debt
   }
   return true;
 }

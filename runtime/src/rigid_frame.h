@@ -49,10 +49,13 @@ struct RigidFrame {
   double homePosition[3] = {};     // where a reset puts the frame (the last set state), at rest
   double homeOrientation[4] = {1, 0, 0, 0};
   double* moments = nullptr;       // 9 x r: y_ab = \int rho p_a U_b at the current state
-  double* products = nullptr;      // 9 x r: A_ab^T q at the centrifugal potential's trial q; then 6 x r its Hessian's
+  double* products = nullptr;      // 9 x r: A_ab^T q at the centrifugal potential's trial q, then
+                                   // 6 x r for its Hessian
   double heldMomentum[3] = {};     // L_b = R^T L - h, body frame, held over a step (holdSpin())
   double heldAngularMomentum[3] = {};  // L when it was held (spinChangedSinceHold())
-  double turnCredit = 0;           // J the turns took from the centrifugal potential, which later turns may give back; < 0: owed
+  // J the turns took from the centrifugal potential, which later turns may give back; negative:
+  // what they added that q' could not give, owed by the next steps.
+  double turnCredit = 0;
 
   static size_t scratchDoubles(int r) { return 24 * static_cast<size_t>(r); }
   // Takes its scratch from `scratch` (scratchDoubles(r) doubles).

@@ -175,16 +175,17 @@ class FreeFlight(unittest.TestCase):
         run(BAKE, mesh, "--E", "1e4", "--nu", "0.45", "--density", "1000", "--quiet", "-o", block)
         m, (a, b, c) = 0.3 * 0.1 * 0.1 * 1000, (0.3, 0.1, 0.1)
         inertia = np.diag([m * (b * b + c * c), m * (a * a + c * c), m * (a * a + b * b)]) / 12
-        for spin, damping in (([0, 0, 40], []), ([0, 0, 100], []), ([-30, 20, 40], []), ([0, 0, 40], ["--alpha", 0, "--beta", 0])):
+        undamped = ["--alpha", 0, "--beta", 0]
+        for spin, damping in (([0, 0, 40], []), ([0, 0, 100], []), ([-30, 20, 40], []), ([0, 0, 40], undamped)):
             out = os.path.join(d, "spun")
             j = json.loads(run(QUIVER, "sim", block + ".qvr", "--free", "--angular-velocity", ",".join(map(str, spin)),
                                *damping, "--steps", 1200, "--hold", 0, "-o", out, "--every", 100000, "--json").stdout)
             energy = np.loadtxt(out + ".csv", delimiter=",", skiprows=1, usecols=(2, 3)).sum(axis=1)
             start = 0.5 * np.dot(spin, inertia @ spin)
-            print(f"soft block spun at {spin} rad/s{' undamped' if damping else ''}: energy {start:.4g} J at the start, at most "
-                  f"{energy.max() / start:.4f} times it, {energy[-1] / start:.3f} after 20 s")
+            print(f"soft block spun at {spin} rad/s{' undamped' if damping else ''}: energy {start:.4g} J at the "
+                  f"start, at most {energy.max() / start:.4f} times it, {energy[-1] / start:.3f} after 20 s")
             self.assertEqual(j["resets"], 0)
-            self.assertLessEqual(energy.max(), start * (1 + 1e-9))
+            self.assertLessEqual(energy.max(), start * (1 + 1e-5))  # the CSV's six digits
 
     def test_spread_bodies_rest_apart_and_sleep(self):
         # --spread: nine bars on a 3 x 3 grid, each landing on its own spot and none touching another.

@@ -26,8 +26,7 @@ struct FreeBar {
   qv_model_info info{};
   Eigen::SparseMatrix<double> mass;  // n x n, the consistent mass's x-x block
 
-  // derivativeAmplitude: SmallModelSpec's (1, the suite's bases), or bakesAmplitude() for the basis
-  // quiver-bake makes of this bar by default.
+  // derivativeAmplitude: SmallModelSpec's (1, the suite's bases), or bakesAmplitude().
   explicit FreeBar(int rank = 10, std::array<int, 3> cells = {6, 1, 1}, Eigen::Vector3d size = {0.6, 0.1, 0.1},
                    double derivativeAmplitude = 1) {
     test::SmallModelSpec spec;
@@ -62,12 +61,13 @@ struct FreeBar {
   }
   ~FreeBar() { qv_model_destroy(model); }
 
-  // The bake's default weighting of the derivatives (--pca-amplitude 0.3 times the extent
-  // ||X - c||_M, precompute/stages/basis.h) for the default bar: 0.13.
-  static double bakesAmplitude() {
+  // The derivatives' weight quiver-bake gives a bar of this size by default (--pca-amplitude 0.3
+  // times its extent ||X - c||_M, precompute/stages/basis.h; 0.13 for the default bar), for a basis
+  // weighted as the bake's (of this bar's k = 6 and r = 10, not the bake's 20 and 30).
+  static double bakesAmplitude(Eigen::Vector3d size = {0.6, 0.1, 0.1}) {
     Material m;
     m.density = kRho;
-    const TetMesh box = makeBoxMesh({0.6, 0.1, 0.1}, {6, 1, 1});
+    const TetMesh box = makeBoxMesh(size, {6, 1, 1});
     return 0.3 * std::sqrt(restMoments(box, std::vector<Material>(box.tetCount(), m)).secondMoment.trace());
   }
 

@@ -2,7 +2,9 @@
 // the world positions it hands out (central differences, the consistent mass of the mesh), free fall
 // against x0 - g t^2 / 2, the momentum a push adds against F h and (x_v - x) x F h, and a spinning
 // bar's stretch against the analytic rho omega^2 L^3 / (12 E), a symmetric top's precession against
-// its closed form, and the energy of fast spins against its start.
+// its closed form, the energy of fast spins against its start (on the suite's basis and on the
+// bake's, where what the turns add beyond the vibration is owed), and the centrifugal potential's
+// gradient and Hessian against central differences.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -173,13 +175,43 @@ TEST(FreeFlight, SnapshotsRewindFlightBitForBit) {
   EXPECT_EQ(bar.positions(inst.s), first);
 }
 
+// A snapshot keeps what the body owes (a negative turn credit, qv_instance::takeOutTurnExcess):
+// the bar on the bake's basis spun at 140 rad/s, saved while it owes, rewinds bit for bit.
+TEST(FreeFlight, SnapshotsKeepWhatTheTurnsAreOwed) {
+  FreeBar bar(10, {6, 1, 1}, {0.6, 0.1, 0.1}, FreeBar::bakesAmplitude());
+  ASSERT_NE(bar.model, nullptr);
+  test::Instance inst(bar.model, bar.config(1.0 / 60));
+  const qv_rigid_state start = {{0, 0, 0}, {1, 0, 0, 0}, {0, 0, 0}, {0, 0, 140}};
+  ASSERT_EQ(qv_instance_set_rigid_state(inst.s, &start), QV_OK);
+  const int r = bar.info.r;
+  const size_t credit = 3 + 3 * static_cast<size_t>(r) + 13;  // the frame's part: instance.h
+  std::vector<double> snapshot(qv_instance_snapshot_size(inst.s) / sizeof(double));
+  int step = 0;
+  for (; step < 1200; ++step) {
+    qv_instance_step(inst.s);
+    qv_instance_save_snapshot(inst.s, snapshot.data());
+    if (snapshot[credit] < 0) break;
+  }
+  ASSERT_LT(step, 1200) << "never owed anything";
+  for (int i = 0; i < 20; ++i) qv_instance_step(inst.s);
+  const Eigen::MatrixXd first = bar.positions(inst.s);
+  ASSERT_EQ(qv_instance_restore_snapshot(inst.s, snapshot.data(), snapshot.size() * sizeof(double)), QV_OK);
+  for (int i = 0; i < 20; ++i) qv_instance_step(inst.s);
+  EXPECT_EQ(bar.positions(inst.s), first);
+  std::vector<double> q(r), v(r);
+  qv_instance_get_state(inst.s, q.data(), v.data(), nullptr);
+  qv_instance_set_state(inst.s, q.data(), v.data(), nullptr);
+  qv_instance_save_snapshot(inst.s, snapshot.data());
+  EXPECT_EQ(snapshot[credit], 0.0);  // a state set anew owes nothing
+}
+
 // Spun fast about a transverse axis (the bar's largest inertia: stable) or tumbling, undamped, at
 // the model's 1/60 s for 20 s: the body's energy stays within a few percent of its start. The
 // steps hold the energy with the frame's spin held at R^T L - h; the body's own energy has
 // omega . h more (h the deformation's angular momentum), which swings: measured none above the
 // start up to 200 rad/s and tumbling, 4.5-6% at 500 rad/s (a tip speed of 150 m/s, the
 // centrifugal stress 11 times the modulus; the figure moves with rounding), where over 100 s it
-// swings between +5% and -3% and ends 20 s within 1% of the start. The frame's turn used to be
+// swings between +5% and -3% and after 20 s is within 1% of the start. The frame's turn used to be
 // the implicit midpoint orientation found by six fixed-point iterations, which diverged past about
 // 0.8 rad a step: at 100 rad/s the energy grew 560-fold in 20 s, tumbling at 71 rad/s 660-fold.
 // Each step's minimisation converges: measured 2.8-5.4 Newton iterations a step up to 200 rad/s;
@@ -266,7 +298,8 @@ TEST(FreeFlight, TheCentrifugalPotentialsGradientAndHessianAreItsDerivatives) {
 // energy rose 4- to 38-fold at six of these twelve spins (125-200 rad/s), the median spin 3.1-fold.
 // Owed, it rises 1.3- to 6.9-fold at four (140-175 rad/s) and by at most 3.5% at the others: the
 // band is narrower, not gone (docs/architecture.md, "Bases"). Chaotic there: which spins rise moves
-// with rounding, so the sweep is judged by its median and its worst.
+// with rounding (measured on the AVX-512 code paths only), so the sweep is judged by how many rise
+// (six of twelve dropped, four owed) and by its worst.
 TEST(FreeFlight, WhatTheTurnsAddBeyondTheVibrationIsOwed) {
   FreeBar bar(10, {6, 1, 1}, {0.6, 0.1, 0.1}, FreeBar::bakesAmplitude());
   ASSERT_NE(bar.model, nullptr);
@@ -285,11 +318,12 @@ TEST(FreeFlight, WhatTheTurnsAddBeyondTheVibrationIsOwed) {
                 highest / first, test::totalEnergy(inst.s) / first);
     rises.push_back(highest / first);
   }
-  std::sort(rises.begin(), rises.end());
-  const double median = 0.5 * (rises[rises.size() / 2 - 1] + rises[rises.size() / 2]);
-  std::printf("the sweep: median %.3g, worst %.3g times the start\n", median, rises.back());
-  EXPECT_LT(median, 1.1);
-  EXPECT_LT(rises.back(), 10.0);  // a bound, not a goal: the band is open
+  const auto risen = std::count_if(rises.begin(), rises.end(), [](double x) { return x > 1.1; });
+  const double worst = *std::max_element(rises.begin(), rises.end());
+  std::printf("the sweep: %d of %zu spins rose by more than 10%%, the worst %.3g times the start\n", int(risen),
+              rises.size(), worst);
+  EXPECT_LE(risen, 5);
+  EXPECT_LT(worst, 20.0);  // bounds, not goals: the band is open
 }
 
 // The turn alone (RigidFrame::move()) on a rigid symmetric top, I = diag(1, 1, 2): in the body
