@@ -205,6 +205,29 @@ TEST(FreeFlight, SnapshotsKeepWhatTheTurnsAreOwed) {
   EXPECT_EQ(snapshot[credit], 0.0);  // a state set anew owes nothing
 }
 
+// One spin of the bar, undamped at 1/60 s for 20 s: its energy at the start, at its highest and at
+// the end, and its Newton iterations a step; false where a step reset.
+struct SpinRun {
+  double first = 0, highest = 0, last = 0, iterationsPerStep = 0;
+};
+bool spinFor20s(const FreeBar& bar, const Eigen::Vector3d& spin, SpinRun& run) {
+  test::Instance inst(bar.model, bar.config(1.0 / 60));
+  const qv_rigid_state start = {{0, 0, 0}, {1, 0, 0, 0}, {0, 0, 0}, {spin.x(), spin.y(), spin.z()}};
+  if (qv_instance_set_rigid_state(inst.s, &start) != QV_OK) return false;
+  run.first = run.highest = test::totalEnergy(inst.s);
+  long iterations = 0;
+  for (int step = 0; step < 1200; ++step) {
+    if (qv_instance_step(inst.s) == QV_STEP_RESET) return false;
+    run.highest = std::max(run.highest, test::totalEnergy(inst.s));
+    qv_step_report report;
+    qv_instance_last_step(inst.s, &report);
+    iterations += report.newton_iterations;
+  }
+  run.last = test::totalEnergy(inst.s);
+  run.iterationsPerStep = static_cast<double>(iterations) / 1200;
+  return true;
+}
+
 // Spun fast about a transverse axis (the bar's largest inertia: stable) or tumbling, undamped, at
 // the model's 1/60 s for 20 s: the body's energy stays within a few percent of its start. The
 // steps hold the energy with the frame's spin held at R^T L - h; the body's own energy has
@@ -223,26 +246,14 @@ TEST(FreeFlight, FastSpinsNeverGainEnergy) {
   ASSERT_NE(bar.model, nullptr);
   const Eigen::Vector3d spins[] = {{0, 0, 50}, {0, 0, 100}, {0, 0, 200}, {0, 0, 500}, {30, 40, 50}, {-120, 90, 150}};
   for (const Eigen::Vector3d& spin : spins) {
-    test::Instance inst(bar.model, bar.config(1.0 / 60));
-    const qv_rigid_state start = {{0, 0, 0}, {1, 0, 0, 0}, {0, 0, 0}, {spin.x(), spin.y(), spin.z()}};
-    ASSERT_EQ(qv_instance_set_rigid_state(inst.s, &start), QV_OK);
-    const auto energy = [&] { return test::totalEnergy(inst.s); };
-    const double first = energy();
-    double highest = first;
-    long iterations = 0;
-    for (int step = 0; step < 1200; ++step) {
-      ASSERT_NE(qv_instance_step(inst.s), QV_STEP_RESET) << spin.transpose() << ", step " << step;
-      highest = std::max(highest, energy());
-      qv_step_report report;
-      qv_instance_last_step(inst.s, &report);
-      iterations += report.newton_iterations;
-    }
-    const double perStep = static_cast<double>(iterations) / 1200;
+    SpinRun run;
+    ASSERT_TRUE(spinFor20s(bar, spin, run)) << spin.transpose() << ": a step reset";
+    const double first = run.first, highest = run.highest, perStep = run.iterationsPerStep;
     std::printf("spun at (%g, %g, %g) rad/s: energy %.4g J at the start, at most %+.2e relative above it, %+.2e after 20 s; %.2f Newton iterations a step\n",
-                spin.x(), spin.y(), spin.z(), first, highest / first - 1, energy() / first - 1, perStep);
+                spin.x(), spin.y(), spin.z(), first, highest / first - 1, run.last / first - 1, perStep);
     const bool fastest = spin.norm() > 300;
     EXPECT_LT(highest, first * (fastest ? 1.1 : 1.01)) << spin.transpose();
-    EXPECT_GT(energy(), 0.5 * first) << spin.transpose();  // not damped away either
+    EXPECT_GT(run.last, 0.5 * first) << spin.transpose();  // not damped away either
     if (!fastest) {
       EXPECT_LT(perStep, 6.5) << spin.transpose();  // converged well before the eighth
     }
@@ -305,18 +316,11 @@ TEST(FreeFlight, WhatTheTurnsAddBeyondTheVibrationIsOwed) {
   ASSERT_NE(bar.model, nullptr);
   std::vector<double> rises;
   for (const double spin : {100.0, 110.0, 120.0, 125.0, 130.0, 140.0, 150.0, 160.0, 175.0, 200.0, 225.0, 250.0}) {
-    test::Instance inst(bar.model, bar.config(1.0 / 60));
-    const qv_rigid_state start = {{0, 0, 0}, {1, 0, 0, 0}, {0, 0, 0}, {0, 0, spin}};
-    ASSERT_EQ(qv_instance_set_rigid_state(inst.s, &start), QV_OK);
-    const double first = test::totalEnergy(inst.s);
-    double highest = first;
-    for (int step = 0; step < 1200; ++step) {
-      ASSERT_NE(qv_instance_step(inst.s), QV_STEP_RESET) << spin << " rad/s, step " << step;
-      highest = std::max(highest, test::totalEnergy(inst.s));
-    }
+    SpinRun run;
+    ASSERT_TRUE(spinFor20s(bar, {0, 0, spin}, run)) << spin << " rad/s: a step reset";
     std::printf("bake's basis spun at %g rad/s: energy at most %.3g times its start, %.3g after 20 s\n", spin,
-                highest / first, test::totalEnergy(inst.s) / first);
-    rises.push_back(highest / first);
+                run.highest / run.first, run.last / run.first);
+    rises.push_back(run.highest / run.first);
   }
   const auto risen = std::count_if(rises.begin(), rises.end(), [](double x) { return x > 1.1; });
   const double worst = *std::max_element(rises.begin(), rises.end());
