@@ -38,6 +38,10 @@ void SimOptions::addScenarioTo(CLI::App& app) {
   app.add_flag("--free", step.freeFlight, "Fly: rigid motion with the deformation (a model baked with no fixed vertex)");
   app.add_flag("--soft-contacts", step.softContacts,
                "Free flight: contacts hold the deformed surface, which gives way where they push (soft objects rest flat)");
+  app.add_option("--max-substeps", step.maxSubsteps,
+                 "Free flight: the most substeps a fast spin's step is cut into, so that the body turns at most 0.75 rad in "
+                 "each (1: never cut; default 16)")
+      ->check(CLI::Range(1, 64));
   flight.addTo(app);
   app.add_option("--dt", step.timeStep, "Time step, s")->check(TimeStep);
   app.add_option("--newton", step.newton,

@@ -75,7 +75,7 @@ qv_instance_config instanceConfig(const Model& model, const std::optional<std::s
                                   std::optional<double> timeStep, std::optional<int> newtonIterations,
                                   std::optional<double> newtonTolerance, std::optional<double> alpha, std::optional<double> beta,
                                   std::optional<int> maxConstraints, std::optional<double> maxDisplacement, bool freeFlight,
-                                  std::optional<int> maxContacts, bool softContacts) {
+                                  std::optional<int> maxContacts, bool softContacts, std::optional<int> maxSubsteps) {
   qv_instance_config c;
   qv_instance_config_init(&c, model.get());
   c.integrator = choice(integrator, c.integrator, qv_integrator_from_name, "integrator", QV_INTEGRATOR_COUNT, qv_integrator_name);
@@ -91,6 +91,7 @@ qv_instance_config instanceConfig(const Model& model, const std::optional<std::s
   c.free_flight = freeFlight ? 1 : 0;
   c.max_contacts = maxContacts.value_or(c.max_contacts);
   c.soft_contacts = softContacts ? 1 : 0;
+  c.max_substeps = maxSubsteps.value_or(c.max_substeps);
   require(c.time_step >= QV_MIN_TIME_STEP && std::isfinite(c.time_step), "time_step must be finite and at least 1e-12 s");
   require(c.newton_iterations >= 1, "newton_iterations must be at least 1");
   require(c.newton_tolerance > 0 && std::isfinite(c.newton_tolerance), "newton_tolerance must be positive and finite");
@@ -99,6 +100,7 @@ qv_instance_config instanceConfig(const Model& model, const std::optional<std::s
   require(c.max_constraints >= 0 && c.max_constraints <= 64, "max_constraints must be between 0 and 64");
   require(c.max_displacement > 0, "max_displacement must be positive");
   require(c.max_contacts >= 0 && c.max_contacts <= 4096, "max_contacts must be between 0 and 4096");
+  require(c.max_substeps >= 1 && c.max_substeps <= 64, "max_substeps must be between 1 and 64");
   require(!freeFlight || model.info().has_rigid_body, "free_flight needs a model baked free (info.has_rigid_body)");
   require(!softContacts || (freeFlight && c.integrator != QV_INTEGRATOR_CENTRAL_DIFFERENCES &&
                              c.elasticity != QV_ELASTICITY_MODAL_WARPING),
@@ -123,6 +125,7 @@ py::dict configDict(const qv_instance_config& c) {
   d["free_flight"] = c.free_flight != 0;
   d["max_contacts"] = c.max_contacts;
   d["soft_contacts"] = c.soft_contacts != 0;
+  d["max_substeps"] = c.max_substeps;
   return d;
 }
 
@@ -273,14 +276,17 @@ angular_velocity (rad/s, world axes). Each attribute reads as a new array and ta
 coordinates, C = alpha I + beta K (Rayleigh). Keeps its model alive.
 
 Instance(model, *, integrator, solver, elasticity, time_step, newton_iterations, newton_tolerance,
-rayleigh_alpha, rayleigh_beta, max_constraints, max_displacement, free_flight, max_contacts, soft_contacts):
+rayleigh_alpha, rayleigh_beta, max_constraints, max_displacement, free_flight, max_contacts, soft_contacts,
+max_substeps):
 each keyword is a field of qv_instance_config; left out (None), it takes qv_instance_config_init's
 default: integrator 'newmark' (or 'euler', 'central'; see quiver.INTEGRATORS), solver 'minimize'
 (or 'newton'), elasticity 'stvk' (or 'linear', 'warping'), the model's time step and damping,
 newton_iterations 8, newton_tolerance 1e-6, max_constraints 4, max_displacement 100 x the model's
 diagonal, free_flight False (True: it flies in a moving frame; needs info.has_rigid_body),
 max_contacts 64, soft_contacts False (True, flying and stepped implicitly: contacts hold the
-deformed surface, which gives way where they push, so a soft object rests flat on what holds it).
+deformed surface, which gives way where they push, so a soft object rests flat on what holds it),
+max_substeps 16 (flying, q's step is cut so that the body turns at most 0.75 rad in each, at most
+this many; 1 never cuts).
 
 Vertex forces and the reduced force are per step (cleared by each step); gravity, constraints and
 colliders persist. Positions and normals are in the world (in flight, carried by the frame).)")
@@ -289,18 +295,18 @@ colliders persist. Positions and normals are in the world (in flight, carried by
                        std::optional<double> timeStep, std::optional<int> newtonIterations, std::optional<double> newtonTolerance,
                        std::optional<double> alpha, std::optional<double> beta, std::optional<int> maxConstraints,
                        std::optional<double> maxDisplacement, bool freeFlight, std::optional<int> maxContacts,
-                       bool softContacts) {
+                       bool softContacts, std::optional<int> maxSubsteps) {
              if (!model) throw py::type_error("model must be a quiver.Model");
              const qv_instance_config config = instanceConfig(*model, integrator, solver, elasticity, timeStep, newtonIterations,
                                                               newtonTolerance, alpha, beta, maxConstraints, maxDisplacement,
-                                                              freeFlight, maxContacts, softContacts);
+                                                              freeFlight, maxContacts, softContacts, maxSubsteps);
              return std::make_unique<Instance>(std::move(model), config);
            }),
            py::arg("model"), py::kw_only(), py::arg("integrator") = py::none(), py::arg("solver") = py::none(),
            py::arg("elasticity") = py::none(), py::arg("time_step") = py::none(), py::arg("newton_iterations") = py::none(),
            py::arg("newton_tolerance") = py::none(), py::arg("rayleigh_alpha") = py::none(), py::arg("rayleigh_beta") = py::none(),
            py::arg("max_constraints") = py::none(), py::arg("max_displacement") = py::none(), py::arg("free_flight") = false,
-           py::arg("max_contacts") = py::none(), py::arg("soft_contacts") = false)
+           py::arg("max_contacts") = py::none(), py::arg("soft_contacts") = false, py::arg("max_substeps") = py::none())
       .def_property_readonly("model", [](const Instance& self) { return self.model; })
       .def_property_readonly("config", [](const Instance& self) { return configDict(self.config); },
                              "the qv_instance_config it was made with, as a dict (choices by name)")
@@ -332,6 +338,7 @@ rest), the worst of the steps taken; last_step describes the last.)")
         d["held_back"] = r.held_back != 0;
         d["energy_removed"] = r.energy_removed;
         d["minimized"] = r.minimized != 0;
+        d["substeps"] = r.substeps;
         return d;
       }, "what the last step did (qv_step_report), as a dict")
       .def_property("q", [](const Instance& self) { return statePart(self, Part::q); },

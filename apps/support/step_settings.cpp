@@ -28,7 +28,7 @@ CLI::Option* addChoice(CLI::App& app, const std::string& flag, Enum& target, int
 bool StepSettings::operator==(const StepSettings& o) const {
   return integrator == o.integrator && elasticity == o.elasticity && timeStep == o.timeStep && newton == o.newton &&
          solver == o.solver && alpha == o.alpha && beta == o.beta && freeFlight == o.freeFlight &&
-         softContacts == o.softContacts;
+         softContacts == o.softContacts && maxSubsteps == o.maxSubsteps;
 }
 
 qv_instance_config instanceConfig(const qv_model* model, const StepSettings& s) {
@@ -43,6 +43,7 @@ qv_instance_config instanceConfig(const qv_model* model, const StepSettings& s) 
   if (s.beta >= 0) c.rayleigh_beta = s.beta;
   c.free_flight = s.freeFlight ? 1 : 0;
   c.soft_contacts = s.softContacts ? 1 : 0;
+  if (s.maxSubsteps != 0) c.max_substeps = s.maxSubsteps;
   return c;
 }
 

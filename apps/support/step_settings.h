@@ -19,6 +19,7 @@ struct StepSettings {
   double alpha = -1, beta = -1;  // Rayleigh damping; negative: the model's
   bool freeFlight = false;       // the object flies (a model baked free): qv_instance_config::free_flight
   bool softContacts = false;     // its contacts hold the deformed surface: qv_instance_config::soft_contacts
+  int maxSubsteps = 0;           // in flight, the most substeps of a fast spin's step: qv_instance_config::max_substeps; 0: the runtime's
 
   bool operator==(const StepSettings& o) const;
 };

@@ -55,6 +55,11 @@ void Loads::endStep() {
   changed = false;
 }
 
+void Loads::continueStep() {
+  std::memcpy(lastStepForce, stepForce, sizeof(double) * r);
+  changed = false;
+}
+
 bool Loads::changedSinceLastStep() const {
   return changed || std::memcmp(stepForce, lastStepForce, sizeof(double) * r) != 0;
 }

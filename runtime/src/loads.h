@@ -48,6 +48,8 @@ struct Loads {
   // it: every state force it steps with must have one, up to a constant).
   const double* addStateForces(const double* q, double* force, double* energy = nullptr) const;
   void endStep();  // the per-step forces are spent, and the persistent ones are the last step's
+  // Between a step's substeps: the next substep's loads are this one's, no change of load.
+  void continueStep();
   // Whether this step's loads differ from the last step's (a per-step force applied again unchanged
   // is no change): the same answer however often a step asks (a fixed Newton step and the minimiser
   // that takes it over both do).

@@ -177,6 +177,18 @@ void RigidFrame::refresh(const qv_model& model, const double* q, const double* q
   solve3(inertia, bodyL, bodyOmega);
 }
 
+double RigidFrame::spinRate(const qv_model& model) const {
+  double bodyL[3], w[3], rest[3], I0[9];
+  rotateBack(rotation, angularMomentum, bodyL);
+  for (int c = 0; c < 3; ++c) bodyL[c] -= internal[c];
+  solve3(inertia, bodyL, w);
+  const double* S0 = Moments(model).S0;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) I0[3 * a + b] = (a == b ? S0[0] + S0[4] + S0[8] : 0.0) - S0[3 * a + b];
+  solve3(I0, bodyL, rest);
+  return std::sqrt(std::fmax(dot(w, w, 3), dot(rest, rest, 3)));
+}
+
 void RigidFrame::worldOmega(double omega[3]) const { rotate(rotation, bodyOmega, omega); }
 
 void RigidFrame::setWorldOmega(const double omega[3]) {

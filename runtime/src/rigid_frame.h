@@ -63,6 +63,9 @@ struct RigidFrame {
   void setOrientation(const double quaternion[4]);  // normalises, updates `rotation`
   // Brings moments, rates and bodyOmega up to date with the frame and (q, q').
   void refresh(const qv_model& model, const double* q, const double* qdot);
+  // |omega| at L as it stands (after this step's torque and contact impulses), with h of the last
+  // refresh() and I(q) of it or of the rest shape, whichever turns faster.
+  double spinRate(const qv_model& model) const;
   // The world angular velocity R bodyOmega.
   void worldOmega(double omega[3]) const;
   // Sets L so that the world angular velocity is `omega` at (q, q') (refresh() first).

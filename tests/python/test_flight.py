@@ -104,6 +104,26 @@ def test_with_soft_contacts_a_beam_rests_flat_on_the_ground(free_model):
             quiver.Instance(free_model, free_flight=True, soft_contacts=True, **bad)
 
 
+def test_a_fast_spin_is_stepped_in_substeps(free_model):
+    # At most 0.75 rad of turn a substep: 100 rad/s at the model's step asks ceil(100 h / 0.75) of
+    # them, max_substeps caps it, and 1 keeps the step whole.
+    def spun(**config):
+        s = quiver.Instance(free_model, free_flight=True, **config)
+        state = s.rigid_state
+        state.angular_velocity = [0, 0, 100]
+        s.rigid_state = state
+        s.step()
+        return s
+    s = spun()
+    assert s.config["max_substeps"] == 16
+    assert s.last_step["substeps"] == int(np.ceil(100 * s.time_step / 0.75)) > 1
+    assert spun(max_substeps=2).last_step["substeps"] == 2
+    assert spun(max_substeps=1).last_step["substeps"] == 1
+    for bad in (0, 65):
+        with pytest.raises(ValueError, match="max_substeps must be between 1 and 64"):
+            quiver.Instance(free_model, free_flight=True, max_substeps=bad)
+
+
 def test_without_the_ground_it_falls_through(free_model):
     s = flyer(free_model, 0.3)
     s.set_colliders([quiver.Plane((0, 0, 1), 0.0)])

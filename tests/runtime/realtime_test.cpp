@@ -148,6 +148,11 @@ TEST(RealTime, BadArgumentsAreRefusedNotCrashed) {
   bad = config;
   bad.newton_iterations = 0;
   EXPECT_EQ(qv_instance_create(m.model, &bad, nullptr, &s), QV_ERROR_INVALID_ARGUMENT);
+  for (const int substeps : {0, 65}) {
+    bad = config;
+    bad.max_substeps = substeps;
+    EXPECT_EQ(qv_instance_create(m.model, &bad, nullptr, &s), QV_ERROR_INVALID_ARGUMENT) << substeps;
+  }
   EXPECT_EQ(qv_instance_create(nullptr, &config, nullptr, &s), QV_ERROR_INVALID_ARGUMENT);
   ASSERT_EQ(qv_instance_create(m.model, &config, nullptr, &s), QV_OK);
   const double f[3] = {1, 0, 0};

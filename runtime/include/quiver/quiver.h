@@ -16,7 +16,7 @@ extern "C" {
 #endif
 
 #define QV_VERSION_MAJOR 0
-#define QV_VERSION_MINOR 13
+#define QV_VERSION_MINOR 14
 #define QV_VERSION_PATCH 0
 #define QV_VERSION_NUMBER (QV_VERSION_MAJOR * 10000 + QV_VERSION_MINOR * 100 + QV_VERSION_PATCH)
 
@@ -231,6 +231,10 @@ typedef struct qv_instance_config {
                                 fixed steps rang against them (a 3 m soft bar resting on the ground: vertices at
                                 5-9 cm/s after 20 s) and, at one or two Newton iterations, threw the bar off. Backward
                                 Euler's fixed steps rest there */
+  int max_substeps;          /* in flight, 1..64: q's step is cut into substeps in which the body turns at most 0.75 rad (a
+                                faster spin made the step's minimisation non-convex, and the energy rose up to 7-fold:
+                                docs/architecture.md, Free flight), at most this many (past that, a substep turns
+                                farther); 1: never cut. Each costs about a step. Default 16 */
 } qv_instance_config;
 
 /* Defaults for `model` (pass NULL for model-independent defaults). */
@@ -274,6 +278,8 @@ typedef struct qv_step_report {
   int minimized;           /* QV_SOLVER_NEWTON: 1 when the minimising solver took the step (the Newton system was not
                               positive definite, the step may have moved a vertex past max_displacement, or, under
                               implicit Newmark, soft contacts were in its solve); the fields above then describe its step */
+  int substeps;            /* the substeps q's step took (qv_instance_config.max_substeps); the fields above sum or
+                              combine theirs */
 } qv_step_report;
 QV_API void qv_instance_last_step(const qv_instance* instance, qv_step_report* report);
 
