@@ -30,6 +30,8 @@
 //   What the step's turn and the deformation's new h change in V between the steps is settled
 //   after q's step in free flight (turnExcess(), qv_instance::takeOutTurnExcess()), so that a
 //   fast spin cannot feed the vibration step after step; with contacts in reach, they take it out.
+//   Where the body turns more than 0.75 rad in a step, the move and q's step go in substeps
+//   (qv_instance::finishStep()).
 //   External forces act on all three: F and x_v x f on the frame, U_v^T R^T f on q.
 #include "model.h"
 
