@@ -423,6 +423,8 @@ qv_result qv_instance_set_rigid_state(qv_instance* s, const qv_rigid_state* stat
   std::memcpy(f.homeOrientation, f.orientation, sizeof f.homeOrientation);
   f.refresh(*s->model, s->q, s->v);
   f.setWorldOmega(state->angular_velocity);
+  // A new spin is a new state: q'' at once what the new centrifugal force gives.
+  s->setState(nullptr, s->v, nullptr);
   return QV_OK;
 }
 

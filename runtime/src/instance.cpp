@@ -386,6 +386,10 @@ void qv_instance::setState(const double* newQ, const double* newV, const double*
   if (newQ) std::memcpy(q, newQ, sizeof(double) * r);
   if (newV) std::memcpy(v, newV, sizeof(double) * r);
   const bool consistentA = !newA && (newQ || newV);
+  if (flying() && (newQ || newV)) {  // the centrifugal force at the new state's spin
+    frame.refresh(*model, q, v);
+    frame.holdSpin();
+  }
   if (newQ || consistentA) quiver::rt::evaluateForces(*this, q);  // R(q) + S(q), K(q)
   // Fixed Newton steps keep E(q) only in their account, which a new q or velocity opens anew.
   const bool newAccount = keepsEnergyAccount() && (newQ || newV);

@@ -166,9 +166,10 @@ class FreeFlight(unittest.TestCase):
         # A 0.3 x 0.1 x 0.1 m block of 10 kPa baked as an artist would (the defaults: 20 modes, r = 30,
         # 2% damping), spun at up to 100 rad/s: a tip speed of 16 m/s, the centrifugal stress about ten
         # times the modulus. The energy at the start is the rigid spin's, w . I w / 2 with the box's
-        # inertia by hand; over 20 s it never rises above it (undamped at 40 rad/s too). Damped, it
-        # settles stretched: a larger inertia at the same angular momentum, half the energy at 100
-        # rad/s. Undamped at 100 rad/s it still rises (docs/architecture.md, "Bases").
+        # inertia by hand; over 20 s it never rises above it. Damped, it settles stretched: a larger
+        # inertia at the same angular momentum, half the energy at 100 rad/s. Undamped at 40 rad/s
+        # the swing of omega . h (docs/architecture.md, Free flight) takes it 0.05% above (until
+        # 2026-11-29 the first step, started from q'' = 0, lost 7% and it stayed below); at most 1%.
         d = self.tmp.name
         mesh, block = os.path.join(d, "block.vtu"), os.path.join(d, "block")
         run(MESH, "beam", "--size", "0.3,0.1,0.1", "--cells", "12,4,4", "-o", mesh)
@@ -185,7 +186,7 @@ class FreeFlight(unittest.TestCase):
             print(f"soft block spun at {spin} rad/s{' undamped' if damping else ''}: energy {start:.4g} J at the "
                   f"start, at most {energy.max() / start:.4f} times it, {energy[-1] / start:.3f} after 20 s")
             self.assertEqual(j["resets"], 0)
-            self.assertLessEqual(energy.max(), start * (1 + 1e-5))  # the CSV's six digits
+            self.assertLessEqual(energy.max(), start * (1.01 if damping else 1 + 1e-5))  # 1e-5: the CSV's six digits
 
     def test_spread_bodies_rest_apart_and_sleep(self):
         # --spread: nine bars on a 3 x 3 grid, each landing on its own spot and none touching another.

@@ -207,16 +207,18 @@ TEST(FreeFlight, SnapshotsKeepWhatTheTurnsAreOwed) {
     for (int i = 1; i < 20; ++i) qv_instance_step(inst.s);
     return bar.positions(inst.s);
   };
+  const double debt = 0.2;  // J, of the 0.5 J q' starts with
   double owing = 0, left = 0, free = 0, held = 0;
-  const Eigen::MatrixXd first = after20(0.2, &owing, &left);
-  EXPECT_EQ(after20(0.2, &owing, &left), first);
+  const Eigen::MatrixXd first = after20(debt, &owing, &left);
+  EXPECT_EQ(after20(debt, &owing, &left), first);
   after20(0.0, &free, &held);
-  std::printf("the first step took %.4g J out of q' owing 0.2 J (%.3g J left), %.4g J owing nothing (%.4g J left)\n",
-              owing, left, free, held);
-  // Owing more than q' held at the step's end, it took all of it.
-  EXPECT_GT(held, 0.01);
-  EXPECT_EQ(left, 0.0);
-  EXPECT_NEAR(owing, free + held, 1e-9);
+  std::printf("the first step took %.4g J out of q' owing %g J (%.4g J left), %.4g J owing nothing (%.4g J left)\n",
+              owing, debt, left, free, held);
+  // The same step otherwise: it takes the debt too, as far as what q' held at its end allows.
+  const double paid = std::min(debt, held);
+  EXPECT_GT(paid, 0.01);
+  EXPECT_NEAR(owing, free + paid, 1e-9);
+  EXPECT_NEAR(left, held - paid, 1e-9);
   qv_instance_get_state(inst.s, q.data(), v.data(), nullptr);
   qv_instance_set_state(inst.s, q.data(), v.data(), nullptr);
   qv_instance_save_snapshot(inst.s, snapshot.data());
@@ -226,7 +228,7 @@ TEST(FreeFlight, SnapshotsKeepWhatTheTurnsAreOwed) {
 // One spin of the bar, undamped at 1/60 s for 20 s: its energy at the start, at its highest and at
 // the end, its substeps a step and Newton iterations a substep; false where a step reset.
 struct SpinRun {
-  double first = 0, highest = 0, last = 0, substepsPerStep = 0, iterationsPerSubstep = 0;
+  double first = 0, afterOne = 0, highest = 0, last = 0, substepsPerStep = 0, iterationsPerSubstep = 0;
 };
 bool spinFor20s(const FreeBar& bar, const Eigen::Vector3d& spin, SpinRun& run) {
   test::Instance inst(bar.model, bar.config(1.0 / 60));
@@ -237,6 +239,7 @@ bool spinFor20s(const FreeBar& bar, const Eigen::Vector3d& spin, SpinRun& run) {
   for (int step = 0; step < 1200; ++step) {
     if (qv_instance_step(inst.s) == QV_STEP_RESET) return false;
     run.highest = std::max(run.highest, test::totalEnergy(inst.s));
+    if (step == 0) run.afterOne = test::totalEnergy(inst.s);
     qv_step_report report;
     qv_instance_last_step(inst.s, &report);
     iterations += report.newton_iterations;
@@ -265,10 +268,13 @@ TEST(FreeFlight, FastSpinsNeverGainEnergy) {
     SpinRun run;
     ASSERT_TRUE(spinFor20s(bar, spin, run)) << spin.transpose() << ": a step reset";
     const double first = run.first, highest = run.highest;
-    std::printf("spun at (%g, %g, %g) rad/s: energy %.4g J at the start, at most %+.2e relative above it, %+.2e after 20 s; "
-                "%.2f substeps a step, %.2f Newton iterations a substep\n",
-                spin.x(), spin.y(), spin.z(), first, highest / first - 1, run.last / first - 1, run.substepsPerStep,
-                run.iterationsPerSubstep);
+    std::printf("spun at (%g, %g, %g) rad/s: energy %.4g J at the start, %+.2e relative after a step, at most %+.2e above it, "
+                "%+.2e after 20 s; %.2f substeps a step, %.2f Newton iterations a substep\n",
+                spin.x(), spin.y(), spin.z(), first, run.afterOne / first - 1, highest / first - 1, run.last / first - 1,
+                run.substepsPerStep, run.iterationsPerSubstep);
+    // The first step starts from the acceleration the spin gives (qv_instance_set_rigid_state): from
+    // q'' = 0, as until 2026-11-29, it lost 1.9-4.6% at 50-100 rad/s, 12% at 500.
+    EXPECT_GT(run.afterOne, (spin.norm() > 300 ? 0.95 : 0.99) * first) << spin.transpose();
     EXPECT_LT(highest, first * 1.01) << spin.transpose();
     EXPECT_GT(run.last, 0.5 * first) << spin.transpose();  // not damped away either
     EXPECT_LT(run.iterationsPerSubstep, 6.5) << spin.transpose();  // converged well before the eighth

@@ -347,7 +347,8 @@ struct FlyingCrowd {
   qv_collider ground = quiver::test::makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0.2);  // the instances keep a pointer
 
   FlyingCrowd(const FlyingCrowd&) = delete;  // its instances point at its `ground`
-  FlyingCrowd(const qv_model* model, const qv_instance_config& config) {
+  // `nudge`: that much more spin about x on each bar (a rounding-sized change, to compare with).
+  FlyingCrowd(const qv_model* model, const qv_instance_config& config, double nudge = 0) {
     const double g[3] = {0, 0, -9.81};
     for (int i = 0; i < 2 * kCount; ++i) {
       owned.push_back(std::make_unique<quiver::test::Instance>(model, config));
@@ -357,7 +358,7 @@ struct FlyingCrowd {
       EXPECT_EQ(qv_instance_get_rigid_state(s, &state), QV_OK);
       state.position[2] = 0.3 + 0.02 * k;
       state.linear_velocity[0] = 0.5 - 0.1 * k;
-      state.angular_velocity[0] = 1.0 + 0.3 * k;
+      state.angular_velocity[0] = 1.0 + 0.3 * k + nudge;
       state.angular_velocity[2] = 2.0 - 0.2 * k;
       EXPECT_EQ(qv_instance_set_rigid_state(s, &state), QV_OK);
       qv_instance_set_gravity(s, g);
@@ -383,14 +384,18 @@ struct FlyingCrowd {
   }
   // The farthest apart two twins' centres are, and their q (and the largest |q| of the single ones).
   void differences(int r, double& position, double& q, double& largestQ) const {
+    differencesFrom(batched, r, position, q, largestQ);
+  }
+  // The same between `others` and the single ones.
+  void differencesFrom(const std::vector<qv_instance*>& others, int r, double& position, double& q, double& largestQ) const {
     position = q = largestQ = 0;
     for (int i = 0; i < kCount; ++i) {
       qv_rigid_state a, b;
-      qv_instance_get_rigid_state(batched[i], &a);
+      qv_instance_get_rigid_state(others[i], &a);
       qv_instance_get_rigid_state(single[i], &b);
       for (int c = 0; c < 3; ++c) position = std::max(position, std::abs(a.position[c] - b.position[c]));
       std::vector<double> qa(r), qb(r);
-      qv_instance_get_state(batched[i], qa.data(), nullptr, nullptr);
+      qv_instance_get_state(others[i], qa.data(), nullptr, nullptr);
       qv_instance_get_state(single[i], qb.data(), nullptr, nullptr);
       for (int k = 0; k < r; ++k) q = std::max(q, std::abs(qa[k] - qb[k])), largestQ = std::max(largestQ, std::abs(qb[k]));
     }
@@ -418,10 +423,12 @@ TEST(StepMany, FlyingInstancesOnTheirCollidersAgreeWithSteppingOneByOne) {
 // Fixed Newton steps that soft contacts touch are the minimiser's (implicit_newmark.cpp) in a
 // group as alone; the group leaves those members out of its evaluation. Soft contacts make the
 // crowd far more sensitive than above: the group's evaluations in flight differ from one state's
-// in the last bits, and so does 1e-13 more spin on each bar, which moves them 3e-9 m apart in the
-// first 0.5 s (the landings) and 7e-5 m by 1.5 s, when one bar settles otherwise. So the twins are
-// compared after the landings: measured 7e-11 m apart. Had a group stepped on with fixed Newton
-// steps, its bars would ring (q to 1.4e-2 against 4e-4 after 1.5 s).
+// in the last bits, and the landings amplify such differences (the minimiser's stopping tests and
+// the contacts' thresholds; qv_instances_step makes no promise past a step the minimiser took).
+// So the twins are compared after the landings (0.5 s) against what a rounding-sized change of
+// the start does: each bar spun 1e-15 rad/s otherwise. Measured: the twins 8e-8 m and 3e-7 in q
+// apart, the nudged bars 8e-7 m and 9e-6 (a 4e-16 rad/s nudge, one last bit, 3e-8 m). Had a group
+// stepped on with fixed Newton steps, its bars would ring (q to 1.4e-2 against 4e-4 after 1.5 s).
 TEST(StepMany, FixedNewtonStepsSoftContactsTouchAreTheMinimisersInAGroupToo) {
   quiver::test::FreeBar bar;
   ASSERT_NE(bar.model, nullptr);
@@ -436,10 +443,22 @@ TEST(StepMany, FixedNewtonStepsSoftContactsTouchAreTheMinimisersInAGroupToo) {
   }
   double worstPosition = 0, worstQ = 0, largestQ = 0;
   crowd.differences(bar.info.r, worstPosition, worstQ, largestQ);
-  std::printf("soft contacts, fixed Newton: minimiser's steps %d of 60 (bar 0, one by one), %d in the group; centres within %.1e m, q within %.1e of its largest %.1e\n",
-              crowd.singleMinimized[0], crowd.batchedMinimized[0], worstPosition, worstQ, largestQ);
-  EXPECT_LT(worstPosition, 1e-7);
-  EXPECT_LT(worstQ, 1e-6 * largestQ);
+  // What the dynamics make of a rounding-sized change: each bar spun 1e-15 rad/s faster or slower
+  // (a few last bits of its 1-4 rad/s), stepped one by one.
+  double nudgedPosition = 0, nudgedQ = 0;
+  for (const double nudge : {1e-15, -1e-15}) {
+    FlyingCrowd nudged(bar.model, config, nudge);
+    nudged.run(bar.model, 60);
+    double p = 0, q = 0, unused = 0;
+    crowd.differencesFrom(nudged.single, bar.info.r, p, q, unused);
+    nudgedPosition = std::max(nudgedPosition, p), nudgedQ = std::max(nudgedQ, q);
+  }
+  std::printf("soft contacts, fixed Newton: minimiser's steps %d of 60 (bar 0, one by one), %d in the group; centres within %.1e m, "
+              "q within %.1e of its largest %.1e; spun 1e-15 rad/s otherwise, %.1e m and %.1e\n",
+              crowd.singleMinimized[0], crowd.batchedMinimized[0], worstPosition, worstQ, largestQ, nudgedPosition, nudgedQ);
+  EXPECT_LT(worstPosition, nudgedPosition);
+  EXPECT_LT(worstQ, nudgedQ);
+  EXPECT_GT(nudgedQ, 1e-9 * largestQ);  // the landings amplify (else the bounds above say nothing)
   crowd.run(bar.model, 120);
   for (const std::vector<qv_instance*>& twins : {crowd.batched, crowd.single})
     for (qv_instance* s : twins) {

@@ -365,7 +365,8 @@ typedef struct qv_rigid_state {
   double linear_velocity[3];   /* m/s, of the centre of mass */
   double angular_velocity[3];  /* rad/s, world axes */
 } qv_rigid_state;
-/* QV_ERROR_INVALID_ARGUMENT for an instance that does not fly or non-finite values. */
+/* QV_ERROR_INVALID_ARGUMENT for an instance that does not fly or non-finite values. Setting it is a new state
+   (qv_instance_set_state with the same q and velocity): the acceleration becomes the one the new spin gives. */
 QV_API qv_result qv_instance_get_rigid_state(const qv_instance* instance, qv_rigid_state* state);
 QV_API qv_result qv_instance_set_rigid_state(qv_instance* instance, const qv_rigid_state* state);
 
