@@ -170,8 +170,9 @@ struct qv_instance {
   qv_step_status endStep(qv_step_status status);  // the per-step loads are spent; a blown-up state resets
   // In flight, after q's step: what the frame's turn added to the centrifugal potential
   // (RigidFrame::turnExcess()) beyond what earlier turns took (RigidFrame::turnCredit) is taken out
-  // of q'; what q' does not hold is owed (a negative credit) by the next steps.
-  void takeOutTurnExcess();
+  // of q'; what q' does not hold is owed (a negative credit) by the next steps. After a step, or
+  // between its substeps (which settle with contacts in reach too).
+  void takeOutTurnExcess(bool betweenSubsteps);
   // The snapshot: r, then q, v, a, E(q) and the energy slack, then in flight the frame (position,
   // orientation, velocity, angular momentum, turn credit), then D's upper triangle row by row,
   // then the last step's per-step forces and whether a persistent load changed since (1 or 0), then
