@@ -651,5 +651,43 @@ TEST(World, BadUseIsRefused) {
   EXPECT_EQ(qv_instance_asleep(nullptr), 0);
 }
 
+// A bar spun at 300 rad/s (18 m/s turns a step, tip speeds of 92 m/s) beside another, its ends
+// sweeping 4 cm below the other's underside: the straight paths the contacts' margins cover would
+// reach 3 m, but the arcs never touch (armReaches(), contact.cpp). Until 2026-11-29 the contacts
+// stopped ends that swing clear; now nothing touches, and the other bar stays where it is. Where
+// the arcs do reach, they still touch.
+TEST(World, ABodyTurningFastIsNotStoppedWhereItsEndsSwingClear) {
+  FreeBar bar;
+  ASSERT_NE(bar.model, nullptr);
+  World world;
+  qv_instance* spinning = world.add(bar, 1.0 / 60, {{0, 0, 0}, {1, 0, 0, 0}, {0, 0, 0}, {0, 300, 0}}, false);
+  qv_instance* still = world.add(bar, 1.0 / 60, {{0, 0, 0.4}, {1, 0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, false);
+  for (int step = 0; step < 30; ++step) {
+    qv_world_step(world.w);
+    EXPECT_EQ(qv_world_contacts(world.w, nullptr, 0), 0) << "step " << step;
+  }
+  qv_rigid_state a, b;
+  qv_instance_get_rigid_state(spinning, &a);
+  qv_instance_get_rigid_state(still, &b);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_EQ(a.position[c], 0.0) << c;
+    EXPECT_EQ(b.position[c], c == 2 ? 0.4 : 0.0) << c;
+    EXPECT_EQ(b.linear_velocity[c], 0.0) << c;
+  }
+  // 2 cm nearer, the ends sweep through the other's underside: they touch it and throw it up.
+  World near;
+  near.add(bar, 1.0 / 60, {{0, 0, 0}, {1, 0, 0, 0}, {0, 0, 0}, {0, 300, 0}}, false);
+  qv_instance* hit = near.add(bar, 1.0 / 60, {{0, 0, 0.33}, {1, 0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, false);
+  int touched = 0;
+  for (int step = 0; step < 5; ++step) {
+    qv_world_step(near.w);
+    touched += qv_world_contacts(near.w, nullptr, 0) > 0;
+  }
+  qv_instance_get_rigid_state(hit, &b);
+  EXPECT_GT(touched, 0);
+  EXPECT_GT(b.linear_velocity[2], 1.0);
+}
+
+
 } // namespace
 } // namespace quiver
