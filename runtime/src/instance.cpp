@@ -286,7 +286,6 @@ qv_step_status qv_instance::finishStep() {
   qv_step_status status = QV_STEP_OK;
   for (int k = 0; k < substeps; ++k) {
     if (k > 0) {
-      dropPresets();
       loads.continueStep();
       takeOutTurnExcess(true);
       frame.refresh(*model, q, v);
@@ -324,20 +323,16 @@ int qv_instance::deformationSubsteps() const {
   return n > 1 ? static_cast<int>(std::fmin(n, config.max_substeps)) : 1;  // NaN: 1 (the step resets)
 }
 
-void qv_instance::dropPresets() {
-  work.presetValid = false;
-  work.presetFactor = quiver::rt::LaneFactor{};
-  // The group's scratch is overwritten after its step, and no step reads K before evaluating it.
-  work.stiffnessPacked = nullptr;
-}
-
 void qv_instance::moveFrame() {
   if (flying()) frame.move(config.time_step);
 }
 
 qv_step_status qv_instance::endStep(qv_step_status status) {
   lastStep.substeps = std::max(lastStep.substeps, 1);
-  dropPresets();
+  work.presetValid = false;
+  work.presetFactor = quiver::rt::LaneFactor{};
+  // The group's scratch is overwritten after its step, and no step reads K before evaluating it.
+  work.stiffnessPacked = nullptr;
   loads.endStep();
   if (flying() && status != QV_STEP_RESET) takeOutTurnExcess(false);
   if (status == QV_STEP_RESET || !healthy()) {

@@ -165,8 +165,9 @@ struct qv_instance {
   void beginOwnStep();  // beginStep() and, in flight, solveOwnContacts(): a step outside a world, up to finishStep()
   qv_step_status finishStep();  // moveFrame() and the integrator's step, in substeps spinning fast; endStep()
   void moveFrame();              // in flight, the frame's move over the step, before q's
-  int deformationSubsteps() const;  // in flight: so that the body turns at most 0.75 rad in each (max_substeps)
-  void dropPresets();               // a group's evaluations at the step's end, which are for the step's end only
+  // In flight, the substeps finishStep() cuts the step into, so that the body turns at most 0.75 rad
+  // in each (max_substeps); after beginStep() and the contacts. A group steps such members alone.
+  int deformationSubsteps() const;
   qv_step_status endStep(qv_step_status status);  // the per-step loads are spent; a blown-up state resets
   // In flight, after q's step: what the frame's turn added to the centrifugal potential
   // (RigidFrame::turnExcess()) beyond what earlier turns took (RigidFrame::turnCredit) is taken out

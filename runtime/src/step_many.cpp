@@ -153,15 +153,22 @@ QV_HOT void solveTogether(qv_instance* const* members, const LaneFactor* factors
 // Fixed Newton steps, up to kLanes: one evaluation each, at the state (fixed_newton.h), and its
 // Newton matrix, both together; then every step up to its first solve, the solves together, and
 // every step's rest. Members whose step is the minimiser's (newmarkStepMinimized()) are not
-// evaluated here.
+// evaluated here; a member spinning fast takes its step in substeps (finishStep()), alone.
 void stepNewtonGroup(qv_instance* const* group, const int* index, int count, double* scratch,
                      qv_step_status* statuses) {
   qv_instance* fixed[kLanes];
   SystemScales scales[kLanes];
   int fixedCount = 0;
+  bool alone[kLanes];
   for (int l = 0; l < count; ++l) {
     qv_instance& s = *group[l];
     s.beginOwnStep();
+    alone[l] = s.deformationSubsteps() > 1;
+    if (alone[l]) {
+      const qv_step_status status = s.finishStep();
+      if (statuses) statuses[index[l]] = status;
+      continue;
+    }
     if (newmarkStepMinimized(s)) continue;
     std::memcpy(s.work.presetAt, s.q, sizeof(double) * s.r);
     double c1, c2;
@@ -177,6 +184,8 @@ void stepNewtonGroup(qv_instance* const* group, const int* index, int count, dou
   LaneFactor factor[kLanes];  // where the first system is solved together: as solveNewton() takes it
   for (int l = 0; l < count; ++l) {
     qv_instance& s = *group[l];
+    going[l] = false, factor[l] = LaneFactor{};
+    if (alone[l]) continue;
     s.moveFrame();  // as finishStep() would
     going[l] = beginNewmarkNewton(s, step[l], status[l]);
     double c1, c2;
@@ -187,6 +196,7 @@ void stepNewtonGroup(qv_instance* const* group, const int* index, int count, dou
   solveTogether(group, factor, count, afterFactors(scratch, group[0]->r));
   for (int l = 0; l < count; ++l) {
     qv_instance& s = *group[l];
+    if (alone[l]) continue;
     if (going[l]) status[l] = endNewmarkNewton(s, step[l], factor[l].A != nullptr);
     status[l] = s.endStep(status[l]);
     if (statuses) statuses[index[l]] = status[l];
@@ -204,17 +214,27 @@ void stepMinimizingTogether(qv_instance* const* instances, Next next, double* sc
   MinimizeTask task[kLanes];
   StepPredictor predictor[kLanes];
   int active = 0, cursor = next(-1);
+  // Takes the next instance into `lane`; false when none is left. One spinning fast takes its step
+  // in substeps (finishStep()), alone, and the next is taken instead.
   const auto admit = [&](int lane) {
+    for (; cursor >= 0; cursor = next(cursor)) {
+      qv_instance& s = *instances[cursor];
+      s.beginOwnStep();
+      if (s.deformationSubsteps() == 1) break;
+      const qv_step_status status = s.finishStep();
+      if (statuses) statuses[cursor] = status;
+    }
+    if (cursor < 0) return false;
     qv_instance& s = *instances[cursor];
-    s.beginOwnStep();
     s.moveFrame();
     predictor[lane] = beginNewmarkMinimization(s);
     task[lane].begin(s, predictor[lane]);
     member[lane] = &s;
     index[lane] = cursor;
     cursor = next(cursor);
+    return true;
   };
-  while (active < kLanes && cursor >= 0) admit(active++);
+  while (active < kLanes && admit(active)) ++active;
   while (active > 0) {
     for (int l = 0; l < active; ++l)
       std::memcpy(member[l]->work.presetAt, task[l].pending(), sizeof(double) * member[l]->r);
@@ -240,8 +260,8 @@ void stepMinimizingTogether(qv_instance* const* instances, Next next, double* sc
       qv_instance& s = *member[l];
       const qv_step_status status = s.endStep(endNewmarkMinimization(s, predictor[l], task[l].status()));
       if (statuses) statuses[index[l]] = status;
-      if (cursor >= 0) {
-        admit(l++);
+      if (admit(l)) {
+        ++l;
       } else {  // the last lane's step moves here
         --active;
         member[l] = member[active], index[l] = index[active], task[l] = task[active], predictor[l] = predictor[active];
