@@ -116,6 +116,7 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
   const std::vector<int> group = selectGroup(mesh, o.group);
   const bool dragMode = o.twist != 0 || o.drag != std::vector<double>{0, 0, 0};
   o.flight.check(o.step.freeFlight);
+  if (!o.step.freeFlight && o.step.maxSubsteps != 0) throw std::runtime_error("--max-substeps needs --free");
   if (o.step.freeFlight) target.startFlight(o);
   if (o.gravity) {
     const double g[3] = {0, 0, -kGravity};

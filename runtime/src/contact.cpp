@@ -16,8 +16,14 @@ namespace {
 constexpr double kSoftness = 0.1;
 constexpr int kSweeps = 24;
 constexpr double kMaxPushOut = 1.0;  // m/s: the fastest a deep penetration is pushed out
-// rad: past this turn in a step, a vertex's straight path strays from its arc by an eighth
-// of its arm, and contacts ask whether its arm can reach at all (armReaches()).
+// rad: past this turn in a step, a vertex's straight path strays from its arc by an eighth of its
+// arm. A contact's margin takes the path as straight, at the vertex's velocity, which for a turn of
+// radians overshoots the arc: a bar spun at 250 rad/s, its ends 0.2 m above the ground, had them
+// stopped at the ground they swing past, and was thrown off it (at 1000 rad/s, 186 m up). But the
+// vertex stays within its arm of the body's centre, which moves straight, and a signed distance
+// changes no faster than the point moves relative to the surface: past this turn a vertex is kept
+// only where the centre's distance, less the arm and that relative travel (twice over the step, as
+// the margins take it), can close.
 constexpr double kStraightTurn = 0.5;
 
 double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -492,21 +498,6 @@ bool pressFacing(const qv_instance& s, int v, double margin, double h, double& d
   return true;
 }
 
-// Whether a vertex of a body turning fast, `arm` from its centre x, can reach a surface within the
-// step. Its margin takes the path as straight, at the vertex's velocity, which for a turn of radians
-// overshoots the arc: a bar spun at 250 rad/s, its ends 0.2 m above the ground, had them stopped at
-// the ground they swing past, and was thrown off it (at 1000 rad/s, 186 m up). But the vertex stays
-// within its arm of the centre, which moves straight, and a signed distance changes no faster than
-// the point moves relative to the surface (`lead`: twice that over the step, as the margins take
-// it): where the centre's distance, less the arm, cannot close, neither can the vertex's.
-// distanceAt(x, reach, d) is the surface's signed distance, false when farther than reach.
-template <class Distance>
-bool armReaches(const double x[3], double arm, double lead, double slop, Distance distanceAt) {
-  const double reach = arm + lead + slop;
-  double centre = 0;
-  return distanceAt(x, reach, centre) && centre <= reach;
-}
-
 double distance3(const double a[3], const double b[3]) {
   const double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
   return norm3(d);
@@ -538,17 +529,13 @@ void findColliderContacts(ContactBody* bodies, int i, const qv_collider* collide
           s.contactSlop + 2 * h * std::fmax(relativeSpeed(bodies[i], u) + flex, bodies[i].groupSpeed);
       const double reach = keptReach(list, margin, s.contactSlop);
       if (!colliderDistance(col, p, reach, depth, normal) || depth > reach) continue;
-      if (swings) {
+      if (swings) {  // can its arm reach (kStraightTurn)?
         const double arm = distance3(p, s.frame.position);
-        double d[3];
+        double d[3], centre, ignored[3];
         for (int a = 0; a < 3; ++a) d[a] = bodies[i].velocity[a] - u[a];
         // The collider's own spin moves its surface by at most |w| times the arm more than at p.
-        const double lead = 2 * h * (norm3(d) + flex + norm3(col.angular_velocity) * arm);
-        const auto distanceAt = [&](const double x[3], double r, double& out) {
-          double ignored[3];
-          return colliderDistance(col, x, r, out, ignored);
-        };
-        if (!armReaches(s.frame.position, arm, lead, s.contactSlop, distanceAt)) continue;
+        const double armReach = arm + 2 * h * (norm3(d) + flex + norm3(col.angular_velocity) * arm) + s.contactSlop;
+        if (!colliderDistance(col, s.frame.position, armReach, centre, ignored) || centre > armReach) continue;
       }
       double own[3];
       const bool facing = pressFacing(s, v, margin, h, depth, normal, own, [&](double& d, double nf[3]) {
@@ -582,16 +569,24 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
   // A side with soft contacts is its deformed surface: a's vertex where its deformation moved it, b's
   // surface moved where its nearest vertex moved along the normal.
   const bool softA = a.modeCompliance != nullptr, softB = b.modeCompliance != nullptr;
-  // Where either turns fast, the straight paths the margin covers overshoot (armReaches()): a's
+  // Where either turns fast, the straight paths the margin covers overshoot (kStraightTurn): a's
   // vertex stays within its arm of a's centre, b's rest surface within its radius of b's. Rigid
   // contacts only (a soft side's deformation moves its surface besides).
   const bool swingsA = !softA && !softB && norm3(bodies[i].omega) * h > kStraightTurn;
   const bool swingsB = !softA && !softB && norm3(bodies[j].omega) * h > kStraightTurn;
+  const double slop = std::fmax(a.contactSlop, b.contactSlop);
   double travel = 0;  // the frames' straight travel against each other (twice, as the margins)
   {
     double d[3];
     for (int k = 0; k < 3; ++k) d[k] = bodies[i].velocity[k] - bodies[j].velocity[k];
     travel = 2 * h * norm3(d);
+  }
+  // a's centre's distance to b's rest surface, whose spin moves it by at most |w| times its radius.
+  const double lead = travel + 2 * h * norm3(bodies[j].omega) * b.surfaceRadius;
+  double centre = INFINITY;
+  if (swingsA) {
+    double ignored[3];
+    if (!bodyDistance(b, a.frame.position, a.surfaceRadius + lead + slop, centre, ignored, nullptr)) centre = INFINITY;
   }
   for (int n = 0; n < a.surfaceCount; ++n) {
     const int v = a.surfaceVertices[n];
@@ -604,17 +599,9 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
     // b's rest surface stays within its radius of b's centre; a's vertex closes on that centre by
     // the frames' travel and its own swing, at most twice its arm (the chord).
     if (swingsB && distance3(p, b.frame.position) >
-                       b.surfaceRadius + travel + 2 * std::fmin(norm3(bodies[i].omega) * h, 2.0) * arm + a.contactSlop)
+                       b.surfaceRadius + travel + 2 * std::fmin(norm3(bodies[i].omega) * h, 2.0) * arm + slop)
       continue;
-    if (swingsA) {
-      const auto distanceAt = [&](const double x[3], double r, double& out) {
-        double ignored[3];
-        return bodyDistance(b, x, r, out, ignored, nullptr);
-      };
-      // b's surface moves besides by its spin, at most |w| times its radius.
-      const double lead = travel + 2 * h * norm3(bodies[j].omega) * b.surfaceRadius;
-      if (!armReaches(a.frame.position, arm, lead, a.contactSlop, distanceAt)) continue;
-    }
+    if (swingsA && centre > arm + lead + slop) continue;
     double own[3];
     int facingVertex = 0;
     const bool facing = pressFacing(a, v, margin, h, depth, normal, own, [&](double& d, double nf[3]) {

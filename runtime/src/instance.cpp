@@ -349,8 +349,8 @@ void qv_instance::takeOutTurnExcess(bool betweenSubsteps) {
   // and a soft bar on the ground still moved at 1e-4 m/s after 3 s). Contacts in reach, not their
   // impulses: whether an impulse is exactly zero is not a choice rounding should make. Between
   // substeps the contacts have acted (on the frame, at the step's start): settled there whatever is
-  // in reach, or a fast spin beside the ground, its contacts in reach and taking nothing, gained
-  // 32-50% (FreeFlight.FastSpinsBesideTheGroundNeverGainEnergy).
+  // in reach, or a bar spun at 500 rad/s tumbling on the ground gained 5%
+  // (FreeFlight.FastSpinsBesideTheGroundNeverGainEnergy).
   if ((!betweenSubsteps && contacts.count > 0) || frame.spinChangedSinceHold()) {
     frame.turnCredit = 0;
     return;
@@ -381,8 +381,8 @@ qv_step_status qv_instance::step() {
 }
 
 void qv_instance::setState(const double* newQ, const double* newV, const double* newA) {
-  if (newQ) std::memcpy(q, newQ, sizeof(double) * r);
-  if (newV) std::memcpy(v, newV, sizeof(double) * r);
+  if (newQ && newQ != q) std::memcpy(q, newQ, sizeof(double) * r);
+  if (newV && newV != v) std::memcpy(v, newV, sizeof(double) * r);  // (a new rigid state passes v itself)
   const bool consistentA = !newA && (newQ || newV);
   if (flying() && (newQ || newV)) {  // the centrifugal force at the new state's spin
     frame.refresh(*model, q, v);
@@ -482,7 +482,12 @@ bool qv_instance::restoreSnapshot(const double* in) {
   if (flying()) {
     const double* f = in + 3 + 3 * r;
     std::memcpy(frame.position, f, 3 * sizeof(double));
-    frame.setOrientation(f + 3);
+    // As saved, so that the steps repeat bit for bit; one not of unit length (crafted) normalised.
+    const double* o = f + 3;
+    if (std::fabs(o[0] * o[0] + o[1] * o[1] + o[2] * o[2] + o[3] * o[3] - 1) <= 1e-12)
+      frame.takeOrientation(o);
+    else
+      frame.setOrientation(o);
     std::memcpy(frame.velocity, f + 7, 3 * sizeof(double));
     std::memcpy(frame.angularMomentum, f + 10, 3 * sizeof(double));
     frame.turnCredit = f[13];  // finite, as checked above; negative: a debt

@@ -143,7 +143,12 @@ void RigidFrame::attach(double* scratch, int r) {
 
 void RigidFrame::setOrientation(const double qn[4]) {
   const double len = std::sqrt(qn[0] * qn[0] + qn[1] * qn[1] + qn[2] * qn[2] + qn[3] * qn[3]);
-  const double w = qn[0] / len, x = qn[1] / len, y = qn[2] / len, z = qn[3] / len;
+  const double unit[4] = {qn[0] / len, qn[1] / len, qn[2] / len, qn[3] / len};
+  takeOrientation(unit);
+}
+
+void RigidFrame::takeOrientation(const double unit[4]) {
+  const double w = unit[0], x = unit[1], y = unit[2], z = unit[3];
   orientation[0] = w, orientation[1] = x, orientation[2] = y, orientation[3] = z;
   const double R[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
                        2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),

@@ -63,6 +63,9 @@ struct RigidFrame {
   // Takes its scratch from `scratch` (scratchDoubles(r) doubles).
   void attach(double* scratch, int r);
   void setOrientation(const double quaternion[4]);  // normalises, updates `rotation`
+  // A unit quaternion as it is (a snapshot's: normalised again, its last bits could move), and
+  // `rotation` from it.
+  void takeOrientation(const double unit[4]);
   // Brings moments, rates and bodyOmega up to date with the frame and (q, q').
   void refresh(const qv_model& model, const double* q, const double* qdot);
   // |omega| at L as it stands (after this step's torque and contact impulses), with h of the last

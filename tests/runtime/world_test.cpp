@@ -653,7 +653,7 @@ TEST(World, BadUseIsRefused) {
 
 // A bar spun at 300 rad/s (18 m/s turns a step, tip speeds of 92 m/s) beside another, its ends
 // sweeping 4 cm below the other's underside: the straight paths the contacts' margins cover would
-// reach 3 m, but the arcs never touch (armReaches(), contact.cpp). Until 2026-11-29 the contacts
+// reach 3 m, but the arcs never touch (kStraightTurn, contact.cpp). Until 2026-11-29 the contacts
 // stopped ends that swing clear; now nothing touches, and the other bar stays where it is. Where
 // the arcs do reach, they still touch.
 TEST(World, ABodyTurningFastIsNotStoppedWhereItsEndsSwingClear) {
@@ -674,7 +674,8 @@ TEST(World, ABodyTurningFastIsNotStoppedWhereItsEndsSwingClear) {
     EXPECT_EQ(b.position[c], c == 2 ? 0.4 : 0.0) << c;
     EXPECT_EQ(b.linear_velocity[c], 0.0) << c;
   }
-  // 2 cm nearer, the ends sweep through the other's underside: they touch it and throw it up.
+  // 7 cm nearer, the ends (0.304 m from the centre) sweep 2.4 cm into the other's underside: they
+  // touch it and throw it up.
   World near;
   near.add(bar, 1.0 / 60, {{0, 0, 0}, {1, 0, 0, 0}, {0, 0, 0}, {0, 300, 0}}, false);
   qv_instance* hit = near.add(bar, 1.0 / 60, {{0, 0, 0.33}, {1, 0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, false);
