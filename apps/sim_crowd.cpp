@@ -41,7 +41,7 @@ int simulateCrowd(const std::string& path, const SimOptions& o, const CrowdOptio
   if (o.drag != none || o.twist != 0) throw std::runtime_error("--instances takes --force and --gravity loads, not --drag or --twist");
   if (o.step.freeFlight) throw std::runtime_error("--instances steps pinned instances; flying ones go in a world (--free --pile)");
   o.flight.check(false);  // --pile and the other flight options need --free
-  if (o.step.maxSubsteps != 0) throw std::runtime_error("--max-substeps needs --free");
+  if (o.step.maxSubsteps != 0) throw std::runtime_error("--max-substeps is for flying instances, which --instances does not step");
   if (!o.output.empty()) throw std::runtime_error("--instances writes no frames: leave out -o");
   const RuntimeModel model(path);
   const TetMesh mesh = model.mesh();

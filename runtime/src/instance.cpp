@@ -459,6 +459,10 @@ bool qv_instance::restoreSnapshot(const double* in) {
   const size_t lastForces = 3 + 3 * static_cast<size_t>(r) + frameSnapshotSize() + static_cast<size_t>(r) * (r + 1) / 2;
   for (size_t i = 1; i < snapshotSize() / sizeof(double); ++i)
     if ((i < lastForces || i >= lastForces + r) && !std::isfinite(in[i])) return false;
+  if (flying()) {  // an orientation of length 0 (crafted) turns nothing
+    const double* o = in + 3 + 3 * r + 3;
+    if (!(o[0] * o[0] + o[1] * o[1] + o[2] * o[2] + o[3] * o[3] > 0)) return false;
+  }
   // D must be positive definite, or the damping would add energy: checked before anything changes.
   const double* savedD = in + 3 + 3 * r + frameSnapshotSize();
   for (int i = 0, k = 0; i < r; ++i)

@@ -174,6 +174,11 @@ TEST(FreeFlight, SnapshotsRewindFlightBitForBit) {
   ASSERT_EQ(qv_instance_restore_snapshot(inst.s, snapshot.data(), snapshot.size() * sizeof(double)), QV_OK);
   for (int i = 0; i < 20; ++i) qv_instance_step(inst.s);
   EXPECT_EQ(bar.positions(inst.s), first);
+  // One whose orientation is zero (crafted) is refused, the instance unchanged.
+  const size_t orientation = 3 + 3 * static_cast<size_t>(bar.info.r) + 3;  // the frame's part: instance.h
+  std::fill(snapshot.begin() + orientation, snapshot.begin() + orientation + 4, 0.0);
+  EXPECT_EQ(qv_instance_restore_snapshot(inst.s, snapshot.data(), snapshot.size() * sizeof(double)), QV_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(bar.positions(inst.s), first);
 }
 
 // A snapshot keeps what the body owes (a negative turn credit, qv_instance::takeOutTurnExcess):

@@ -340,9 +340,11 @@ QV_API void qv_instance_set_state(qv_instance* instance, const double* q, const 
    budget compares with) as an opaque block of qv_instance_snapshot_size() bytes, for rewinding,
    replays and save games: restoring a snapshot and repeating the same calls repeats the same bits.
    Restoring checks the size, that the snapshot came from a model of the same r, that its values
-   are finite (but for the last step's forces, where a step that reset may leave one that is not)
-   and that its damping stiffness is positive definite (QV_ERROR_INVALID_ARGUMENT
-   otherwise, the instance unchanged). Restoring also restores whether a persistent load had changed since that step, so
+   are finite (but for the last step's forces, where a step that reset may leave one that is not),
+   that a flying instance's orientation is not zero and that its damping stiffness is positive
+   definite (QV_ERROR_INVALID_ARGUMENT otherwise, the instance unchanged). A flying instance's
+   contacts are not in it: the next step's start cold (without the impulses the last step ended
+   with), so one in contact does not repeat its steps bit for bit. Restoring also restores whether a persistent load had changed since that step, so
    set loads after restoring, as the calls being repeated would. The layout may change between runtime
    versions (a flying instance's did after 0.13): the size check refuses another's. Saving uses the instance's scratch
    (QV_SOLVER_NEWTON: it evaluates the state), so save one instance from one thread at a time. */
