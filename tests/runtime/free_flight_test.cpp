@@ -160,6 +160,17 @@ TEST(FreeFlight, APushAddsItsImpulseAndItsAngularImpulse) {
   EXPECT_LT((L - expected).norm(), 0.02 * expected.norm()) << L.transpose() << " vs " << expected.transpose();
 }
 
+// Steps 20 on from the state `snapshot` holds (the instance's own), restores it and steps the 20
+// again: both ends must agree bit for bit. Returns the positions reached.
+Eigen::MatrixXd twentyStepsTwice(const FreeBar& bar, qv_instance* s, const std::vector<double>& snapshot) {
+  for (int i = 0; i < 20; ++i) qv_instance_step(s);
+  const Eigen::MatrixXd first = bar.positions(s);
+  EXPECT_EQ(qv_instance_restore_snapshot(s, snapshot.data(), snapshot.size() * sizeof(double)), QV_OK);
+  for (int i = 0; i < 20; ++i) qv_instance_step(s);
+  EXPECT_EQ(bar.positions(s), first);
+  return first;
+}
+
 TEST(FreeFlight, SnapshotsRewindFlightBitForBit) {
   FreeBar bar;
   ASSERT_NE(bar.model, nullptr);
@@ -169,11 +180,7 @@ TEST(FreeFlight, SnapshotsRewindFlightBitForBit) {
   for (int i = 0; i < 5; ++i) qv_instance_step(inst.s);
   std::vector<double> snapshot(qv_instance_snapshot_size(inst.s) / sizeof(double));
   qv_instance_save_snapshot(inst.s, snapshot.data());
-  for (int i = 0; i < 20; ++i) qv_instance_step(inst.s);
-  const Eigen::MatrixXd first = bar.positions(inst.s);
-  ASSERT_EQ(qv_instance_restore_snapshot(inst.s, snapshot.data(), snapshot.size() * sizeof(double)), QV_OK);
-  for (int i = 0; i < 20; ++i) qv_instance_step(inst.s);
-  EXPECT_EQ(bar.positions(inst.s), first);
+  const Eigen::MatrixXd first = twentyStepsTwice(bar, inst.s, snapshot);
   // One whose orientation is zero (crafted) is refused, the instance unchanged.
   const size_t orientation = 3 + 3 * static_cast<size_t>(bar.info.r) + 3;  // the frame's part: instance.h
   std::fill(snapshot.begin() + orientation, snapshot.begin() + orientation + 4, 0.0);
@@ -250,11 +257,7 @@ TEST(FreeFlight, SnapshotsTakenWhileOwingRewindBitForBit) {
     if (snapshot[credit] < 0) break;
   }
   ASSERT_LT(step, 1200) << "never owed anything";
-  for (int i = 0; i < 20; ++i) qv_instance_step(inst.s);
-  const Eigen::MatrixXd first = bar.positions(inst.s);
-  ASSERT_EQ(qv_instance_restore_snapshot(inst.s, snapshot.data(), snapshot.size() * sizeof(double)), QV_OK);
-  for (int i = 0; i < 20; ++i) qv_instance_step(inst.s);
-  EXPECT_EQ(bar.positions(inst.s), first);
+  twentyStepsTwice(bar, inst.s, snapshot);
 }
 
 // One spin of the bar, undamped at 1/60 s for 20 s: its energy at the start, at its highest and at
