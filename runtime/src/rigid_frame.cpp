@@ -41,6 +41,13 @@ void solve3(const double S[9], const double b[3], double x[3]) {
   x[2] = (c02 * b[0] + c12 * b[1] + c22 * b[2]) / det;
 }
 
+// The inertia of second moments S = \int rho p p^T: tr(S) 1 - S, symmetrised.
+void inertiaOf(const double S[9], double I[9]) {
+  const double trace = S[0] + S[4] + S[8];
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) I[3 * a + b] = (a == b ? trace : 0.0) - 0.5 * (S[3 * a + b] + S[3 * b + a]);
+}
+
 // S^-1 (row-major, symmetric) of a symmetric positive definite 3 x 3 S, column by column.
 void inverse3(const double S[9], double out[9]) {
   for (int c = 0; c < 3; ++c) {
@@ -167,9 +174,7 @@ void RigidFrame::refresh(const qv_model& model, const double* q, const double* q
     for (int b = 0; b < 3; ++b)
       S[3 * a + b] = mo.S0[3 * a + b] + dot(mo.B + (3 * b + a) * static_cast<size_t>(r), q, r) +
                      dot(moments + (3 * a + b) * static_cast<size_t>(r), q, r);
-  const double trace = S[0] + S[4] + S[8];
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) inertia[3 * a + b] = (a == b ? trace : 0.0) - 0.5 * (S[3 * a + b] + S[3 * b + a]);
+  inertiaOf(S, inertia);
   for (int c = 0; c < 3; ++c) {
     internal[c] = 0;
     for (int a = 0; a < 3; ++a)
@@ -187,9 +192,7 @@ double RigidFrame::spinRate(const qv_model& model) const {
   rotateBack(rotation, angularMomentum, bodyL);
   for (int c = 0; c < 3; ++c) bodyL[c] -= internal[c];
   solve3(inertia, bodyL, w);
-  const double* S0 = Moments(model).S0;
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) I0[3 * a + b] = (a == b ? S0[0] + S0[4] + S0[8] : 0.0) - S0[3 * a + b];
+  inertiaOf(Moments(model).S0, I0);
   solve3(I0, bodyL, rest);
   return std::sqrt(std::fmax(dot(w, w, 3), dot(rest, rest, 3)));
 }
@@ -235,10 +238,8 @@ double RigidFrame::addCentrifugal(const qv_model& model, const double* q, double
     S[ab] = mo.S0[ab] + dot(mo.B + ab * static_cast<size_t>(r), q, r) + dot(mo.B + (3 * b + a) * static_cast<size_t>(r), q, r) +
             dot(q, products + ab * static_cast<size_t>(r), r);
   }
-  const double trace = S[0] + S[4] + S[8];
   double I[9], w[3];
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) I[3 * a + b] = (a == b ? trace : 0.0) - 0.5 * (S[3 * a + b] + S[3 * b + a]);
+  inertiaOf(S, I);
   solve3(I, heldMomentum, w);
   // dV/dq_j = -omega . I_j omega / 2 = -sum_ab W_ab (B_ab + A_ab q)_j, I_j = dI/dq_j and
   // W_ab = |omega|^2 d_ab - omega_a omega_b (A_ab q = products[ba], W symmetric).
