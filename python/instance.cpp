@@ -69,6 +69,19 @@ void require(bool ok, const std::string& message) {
   if (!ok) throw py::value_error(message);
 }
 
+// Restores `snapshot` with restore(data, size) (8-byte aligned, as the C API wants), or raises.
+template <class Restore>
+void restoreSnapshot(const py::bytes& snapshot, const std::string& whose, size_t most, Restore restore) {
+  const std::string bytes = snapshot;
+  const std::string size = "snapshot of " + std::to_string(bytes.size()) + " bytes";
+  require(bytes.size() <= most, size + "; " + whose + " take at most " + std::to_string(most));
+  std::vector<double> aligned(bytes.size() / sizeof(double) + 1);
+  std::memcpy(aligned.data(), bytes.data(), bytes.size());
+  require(restore(aligned.data(), bytes.size()) == QV_OK,
+          size + " refused: not one " + whose + " could have saved (cut short, another model's r or another membership, a "
+          "value not finite, a damping stiffness not positive definite, or contacts no step could have ended with)");
+}
+
 // qv_instance_config_init's defaults with the keyword arguments given, each checked with a message.
 qv_instance_config instanceConfig(const Model& model, const std::optional<std::string>& integrator,
                                   const std::optional<std::string>& solver, const std::optional<std::string>& elasticity,
@@ -360,19 +373,14 @@ rest), the worst of the steps taken; last_step describes the last.)")
       }, "(kinetic, elastic) energy in J")
       .def("save_snapshot", [](const Instance& self) {
         std::string bytes(qv_instance_snapshot_size(self.use()), '\0');
-        qv_instance_save_snapshot(self.use(), bytes.data());
+        bytes.resize(qv_instance_save_snapshot(self.use(), bytes.data()));
         return py::bytes(bytes);
-      }, "Everything that evolves, as bytes: restoring them and repeating the same calls repeats the same bits.")
+      }, "Everything that evolves (in flight its contacts too), as bytes: restoring them and repeating the same calls "
+         "repeats the same bits.")
       .def("restore_snapshot", [](Instance& self, const py::bytes& snapshot) {
-        const std::string bytes = snapshot;
-        const size_t expected = qv_instance_snapshot_size(self.use());
-        if (bytes.size() != expected)
-          throw py::value_error("snapshot of " + std::to_string(bytes.size()) + " bytes; this instance's are " +
-                                std::to_string(expected));
-        std::vector<double> aligned(bytes.size() / sizeof(double) + 1);
-        std::memcpy(aligned.data(), bytes.data(), bytes.size());
-        if (qv_instance_restore_snapshot(self.use(), aligned.data(), bytes.size()) != QV_OK)
-          throw py::value_error("snapshot is not of a model with this instance's r, holds a value that is not finite, or its damping stiffness is not positive definite");
+        restoreSnapshot(snapshot, "this instance's", qv_instance_snapshot_size(self.use()), [&](const void* data, size_t size) {
+          return qv_instance_restore_snapshot(self.use(), data, size);
+        });
       }, py::arg("snapshot"))
       .def("add_vertex_force", [](Instance& self, long long vertex, py::handle force) {
         checkVertex(vertex, self.model->info().vertex_count);
@@ -540,7 +548,18 @@ and returns how many reset. The world keeps its instances alive.)")
         return qv_world_step(world);
       }, "Steps every awake instance once; returns how many reset (never expected).")
       .def("contacts", [](const World& self) { return contactArray(static_cast<const qv_world*>(self.use()), qv_world_contacts); },
-           "The last step's contacts, as Instance.contacts(); `instance` and `other` say who touched whom.");
+           "The last step's contacts, as Instance.contacts(); `instance` and `other` say who touched whom.")
+      .def("save_snapshot", [](const World& self) {
+        std::string bytes(qv_world_snapshot_size(self.use()), '\0');
+        bytes.resize(qv_world_save_snapshot(self.use(), bytes.data()));
+        return py::bytes(bytes);
+      }, "Every instance's snapshot, whether it sleeps, and the contacts between them, as bytes: restoring them and "
+         "repeating the same calls repeats the same bits (the colliders are the caller's to restore).")
+      .def("restore_snapshot", [](World& self, const py::bytes& snapshot) {
+        restoreSnapshot(snapshot, "this world's", qv_world_snapshot_size(self.use()), [&](const void* data, size_t size) {
+          return qv_world_restore_snapshot(self.use(), data, size);
+        });
+      }, py::arg("snapshot"));
 }
 
 } // namespace quiver_python

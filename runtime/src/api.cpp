@@ -373,15 +373,15 @@ void qv_instance_set_state(qv_instance* s, const double* q, const double* v, con
 
 size_t qv_instance_snapshot_size(const qv_instance* s) { return s ? s->snapshotSize() : 0; }
 
-void qv_instance_save_snapshot(const qv_instance* s, void* snapshot) {
-  if (s && snapshot) s->saveSnapshot(static_cast<double*>(snapshot));
+size_t qv_instance_save_snapshot(const qv_instance* s, void* snapshot) {
+  return s && snapshot ? s->saveSnapshot(static_cast<double*>(snapshot)) : 0;
 }
 
 qv_result qv_instance_restore_snapshot(qv_instance* s, const void* snapshot, size_t size) {
-  if (!s || !snapshot || size != s->snapshotSize() || reinterpret_cast<uintptr_t>(snapshot) % alignof(double) != 0)
-    return QV_ERROR_INVALID_ARGUMENT;
+  if (!s || !snapshot || reinterpret_cast<uintptr_t>(snapshot) % alignof(double) != 0) return QV_ERROR_INVALID_ARGUMENT;
+  if (!s->restoreSnapshot(static_cast<const double*>(snapshot), size)) return QV_ERROR_INVALID_ARGUMENT;
   s->wake();
-  return s->restoreSnapshot(static_cast<const double*>(snapshot)) ? QV_OK : QV_ERROR_INVALID_ARGUMENT;
+  return QV_OK;
 }
 
 void qv_instance_reset(qv_instance* s) {
@@ -533,6 +533,17 @@ int qv_instance_asleep(const qv_instance* s) { return s && s->asleep; }
 
 void qv_instance_wake(qv_instance* s) {
   if (s) s->wake();
+}
+
+size_t qv_world_snapshot_size(const qv_world* world) { return world ? world->snapshotSize() : 0; }
+
+size_t qv_world_save_snapshot(const qv_world* world, void* snapshot) {
+  return world && snapshot ? world->saveSnapshot(static_cast<double*>(snapshot)) : 0;
+}
+
+qv_result qv_world_restore_snapshot(qv_world* world, const void* snapshot, size_t size) {
+  if (!world || !snapshot || reinterpret_cast<uintptr_t>(snapshot) % alignof(double) != 0) return QV_ERROR_INVALID_ARGUMENT;
+  return world->restoreSnapshot(static_cast<const double*>(snapshot), size) ? QV_OK : QV_ERROR_INVALID_ARGUMENT;
 }
 
 int qv_world_contacts(const qv_world* world, qv_contact* contacts, int capacity) {

@@ -331,15 +331,6 @@ void keepLevels(ContactList& list) {
   }
 }
 
-// Contacts by who touches what where: the warm start finds last step's by it, and the solve runs
-// in its order whichever contacts the capacity kept.
-bool keyBefore(const Contact& x, const Contact& y) {
-  if (x.body != y.body) return x.body < y.body;
-  if (x.other != y.other) return x.other < y.other;
-  if (x.collider != y.collider) return x.collider < y.collider;
-  return x.vertex < y.vertex;
-}
-
 // How fast body b's surface can move relative to something moving at `velocity`: the frame's
 // relative velocity plus its spin at its farthest vertex.
 double relativeSpeed(const ContactBody& b, const double velocity[3]) {

@@ -37,6 +37,15 @@ struct Contact {
   const double* otherRows = nullptr;
 };
 
+// Contacts by who touches what where: the warm start finds last step's by it, and the solve runs
+// in its order whichever contacts the capacity kept.
+inline bool keyBefore(const Contact& x, const Contact& y) {
+  if (x.body != y.body) return x.body < y.body;
+  if (x.other != y.other) return x.other < y.other;
+  if (x.collider != y.collider) return x.collider < y.collider;
+  return x.vertex < y.vertex;
+}
+
 // One body's candidate contacts with one collider or one other body in a step.
 struct ContactPair {
   int body = 0, other = -1, collider = -1;
@@ -64,5 +73,19 @@ struct ContactList {
     full = false;
   }
 };
+
+// The last step's contacts as a snapshot carries them: what the next step warm-starts from and
+// what qv_instance_contacts reports, kContactRecord doubles each after their count.
+constexpr size_t kContactRecord = 20;
+// Writes the count and the records; returns the doubles written.
+size_t saveContacts(const ContactList& list, double* out);
+// How many doubles the contacts at `in` take (their count and records), or 0 where they are not a
+// list a step of `bodies` (their indices' order) could have ended with: the count within the
+// list's capacity and the `available` doubles, each record finite, of a body and its vertex, and
+// another body or a collider, with a non-negative normal impulse, in the solve's order.
+size_t validContacts(const double* in, size_t available, const ContactList& list, const qv_instance* const* bodies,
+                     int bodyCount);
+// Makes them the last step's (validContacts() first).
+void restoreContacts(ContactList& list, const double* in);
 
 } // namespace quiver::rt

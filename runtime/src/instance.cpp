@@ -411,7 +411,7 @@ void qv_instance::setState(const double* newQ, const double* newV, const double*
   if (newAccount) openEnergyAccount(elasticEnergyAtState);
 }
 
-void qv_instance::saveSnapshot(double* out) const {
+void qv_instance::saveState(double* out) const {
   out[0] = r;
   std::memcpy(out + 1, q, sizeof(double) * r);
   std::memcpy(out + 1 + r, v, sizeof(double) * r);
@@ -452,22 +452,26 @@ void qv_instance::saveSnapshot(double* out) const {
   f[2 * r + 3] = account ? exactEndChecks : 0;
 }
 
-bool qv_instance::restoreSnapshot(const double* in) {
+bool qv_instance::validState(const double* in) const {
   if (in[0] != r) return false;
   // A state, a budget, a frame or an account that is not finite would only be reset by the next
   // step. The last step's forces may hold one (a step that reset): it only marks a change.
   const size_t lastForces = 3 + 3 * static_cast<size_t>(r) + frameSnapshotSize() + static_cast<size_t>(r) * (r + 1) / 2;
-  for (size_t i = 1; i < snapshotSize() / sizeof(double); ++i)
+  for (size_t i = 1; i < stateSize(); ++i)
     if ((i < lastForces || i >= lastForces + r) && !std::isfinite(in[i])) return false;
   if (flying()) {  // an orientation of length 0 (crafted) turns nothing
     const double* o = in + 3 + 3 * r + 3;
     if (!(o[0] * o[0] + o[1] * o[1] + o[2] * o[2] + o[3] * o[3] > 0)) return false;
   }
-  // D must be positive definite, or the damping would add energy: checked before anything changes.
+  // D must be positive definite, or the damping would add energy.
   const double* savedD = in + 3 + 3 * r + frameSnapshotSize();
   for (int i = 0, k = 0; i < r; ++i)
     for (int j = i; j < r; ++j) work.system[i * r + j] = savedD[k++];
-  if (!quiver::rt::choleskyFactor(work.system, r)) return false;
+  return quiver::rt::choleskyFactor(work.system, r);
+}
+
+void qv_instance::restoreState(const double* in) {
+  const double* savedD = in + 3 + 3 * r + frameSnapshotSize();
   for (int i = 0, k = 0; i < r; ++i)
     for (int j = i; j < r; ++j, ++k) dampingStiffness[i * r + j] = dampingStiffness[j * r + i] = savedD[k];
   const double* savedLoads = savedD + static_cast<size_t>(r) * (r + 1) / 2;
@@ -482,7 +486,6 @@ bool qv_instance::restoreSnapshot(const double* in) {
   previousElastic = savedLoads[r + 2];
   std::memcpy(previousQ, savedLoads + r + 3, sizeof(double) * r);
   exactEndChecks = static_cast<int>(std::fmin(std::fmax(savedLoads[2 * r + 3], 0.0), 1e6));
-  contacts.clear();  // the snapshot does not carry them: the next step's contacts start cold
   if (flying()) {
     const double* f = in + 3 + 3 * r;
     std::memcpy(frame.position, f, 3 * sizeof(double));
@@ -496,6 +499,22 @@ bool qv_instance::restoreSnapshot(const double* in) {
     std::memcpy(frame.angularMomentum, f + 10, 3 * sizeof(double));
     frame.turnCredit = f[13];  // finite, as checked above; negative: a debt
   }
+}
+
+size_t qv_instance::saveSnapshot(double* out) const {
+  saveState(out);
+  return sizeof(double) * (stateSize() + (flying() ? quiver::rt::saveContacts(contacts, out + stateSize()) : 0));
+}
+
+bool qv_instance::restoreSnapshot(const double* in, size_t bytes) {
+  const size_t available = bytes / sizeof(double);
+  if (bytes > snapshotSize() || available < stateSize() || !validState(in)) return false;
+  const qv_instance* self = this;
+  const size_t held = flying() ? quiver::rt::validContacts(in + stateSize(), available - stateSize(), contacts, &self, 1) : 0;
+  if (flying() && !held) return false;
+  restoreState(in);
+  // Its contacts, which the next step warm-starts from; a world's members keep theirs in the world.
+  if (flying()) quiver::rt::restoreContacts(contacts, in + stateSize());
   return true;
 }
 

@@ -174,17 +174,26 @@ struct qv_instance {
   // of q'; what q' does not hold is owed (a negative credit) by the next steps. After a step, or
   // between its substeps (which settle with contacts in reach too).
   void takeOutTurnExcess(bool betweenSubsteps);
-  // The snapshot: r, then q, v, a, E(q) and the energy slack, then in flight the frame (position,
-  // orientation, velocity, angular momentum, turn credit), then D's upper triangle row by row,
-  // then the last step's per-step forces and whether a persistent load changed since (1 or 0), then
-  // the fixed Newton account (the elastic allowance, the previous E(q) and q, the exact end checks
-  // left), as doubles: all a step reads beyond the caller's calls.
-  size_t snapshotSize() const {
+  // The snapshot: its state, then in flight the last step's contacts (contact_list.h). The state:
+  // r, then q, v, a, E(q) and the energy slack, then in flight the frame (position, orientation,
+  // velocity, angular momentum, turn credit), then D's upper triangle row by row, then the last
+  // step's per-step forces and whether a persistent load changed since (1 or 0), then the fixed
+  // Newton account (the elastic allowance, the previous E(q) and q, the exact end checks left), as
+  // doubles: all a step reads beyond the caller's calls. A world's snapshot (world.h) holds its
+  // members' states and its own contacts.
+  size_t stateSize() const {
     const size_t n = static_cast<size_t>(r);
-    return sizeof(double) * (3 * n + 3 + frameSnapshotSize() + n * (n + 1) / 2 + 2 * n + 4);
+    return 3 * n + 3 + frameSnapshotSize() + n * (n + 1) / 2 + 2 * n + 4;
   }
   size_t frameSnapshotSize() const { return flying() ? 14 : 0; }
-  void saveSnapshot(double* out) const;
-  bool restoreSnapshot(const double* in);
+  void saveState(double* out) const;
+  bool validState(const double* in) const;  // checks D in the scratch: one thread at a time
+  void restoreState(const double* in);      // validState() first
+  // Bytes: the most a snapshot takes (every contact held), and what this one took.
+  size_t snapshotSize() const {
+    return sizeof(double) * (stateSize() + (flying() ? 1 + quiver::rt::kContactRecord * static_cast<size_t>(contacts.capacity) : 0));
+  }
+  size_t saveSnapshot(double* out) const;
+  bool restoreSnapshot(const double* in, size_t bytes);
   void energies(double* kinetic, double* elastic) const;
 };

@@ -131,6 +131,53 @@ int qv_world::step() {
   return resets;
 }
 
+size_t qv_world::snapshotSize() const {
+  size_t doubles = 2 + quiver::rt::kContactRecord * static_cast<size_t>(contacts.capacity);
+  for (int i = 0; i < count; ++i) doubles += 3 + instances[i]->stateSize();
+  return sizeof(double) * doubles;
+}
+
+size_t qv_world::saveSnapshot(double* out) const {
+  double* o = out;
+  *o++ = count;
+  for (int i = 0; i < count; ++i) {
+    const qv_instance& s = *instances[i];
+    o[0] = s.asleep ? 1 : 0, o[1] = s.stillTime, o[2] = s.sleepGroup;
+    s.saveState(o + 3);
+    o += 3 + s.stateSize();
+  }
+  o += quiver::rt::saveContacts(contacts, o);
+  return sizeof(double) * static_cast<size_t>(o - out);
+}
+
+bool qv_world::restoreSnapshot(const double* in, size_t bytes) {
+  // All checked before anything changes: the same number of instances, each one's sleep and state
+  // valid for it, and contacts between them.
+  const size_t available = bytes / sizeof(double);
+  if (bytes > snapshotSize() || available < 1 || in[0] != count) return false;
+  size_t at = 1;
+  for (int i = 0; i < count; ++i) {
+    const qv_instance& s = *instances[i];
+    if (available < at + 3 + s.stateSize()) return false;
+    const double* sleep = in + at;
+    if ((sleep[0] != 0 && sleep[0] != 1) || !(sleep[1] >= 0 && sleep[1] < INFINITY) ||
+        !(sleep[2] >= -1 && sleep[2] < count && sleep[2] == std::floor(sleep[2])) || !s.validState(sleep + 3))
+      return false;
+    at += 3 + s.stateSize();
+  }
+  if (!quiver::rt::validContacts(in + at, available - at, contacts, instances, count)) return false;
+  at = 1;
+  for (int i = 0; i < count; ++i) {
+    qv_instance& s = *instances[i];
+    s.asleep = in[at] != 0, s.stillTime = in[at + 1], s.sleepGroup = static_cast<int>(in[at + 2]);
+    s.restoreState(in + at + 3);
+    s.contacts.clear();  // a world step clears them
+    at += 3 + s.stateSize();
+  }
+  quiver::rt::restoreContacts(contacts, in + at);
+  return true;
+}
+
 void qv_world::wakeSleptWith() {
   // The caller woke these (and may have moved them away from the rest of their group): the
   // bodies they fell asleep with wake too (a stack whose lowest is taken away must fall). A

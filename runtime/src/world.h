@@ -29,6 +29,12 @@ struct qv_world {
   // Each awake instance's frame forces, one contact solve over all, then each move and deformation;
   // then the groups that have been still long enough fall asleep.
   int step();
+  // The snapshot (qv_world_save_snapshot): how many instances, then each one's sleep (asleep, still
+  // time, sleep group) and state (qv_instance::saveState()), then the last step's contacts
+  // (contact_list.h), as doubles. Bytes: the most it takes (every contact held), and what one took.
+  size_t snapshotSize() const;
+  size_t saveSnapshot(double* out) const;
+  bool restoreSnapshot(const double* in, size_t bytes);
   void wakeSleptWith();
   void begin(int i);
   void settle(double h);

@@ -169,6 +169,36 @@ def test_a_world_stacks_one_beam_on_another(free_model):
         quiver.World(sleep_speed=-1)
 
 
+def test_a_world_snapshot_rewinds_a_stack_landing_bit_for_bit(free_model):
+    world = quiver.World()
+    low, high = flyer(free_model, 0.06), flyer(free_model, 0.25)
+    world.add(low), world.add(high)
+    world.set_colliders([quiver.Plane((0, 0, 1), 0.0)])
+
+    def run(steps):
+        for _ in range(steps):
+            assert world.step() == 0
+        return [s.positions() for s in world.instances], world.contacts(), [s.asleep for s in world.instances]
+
+    run(20)  # the upper is landing on the lower
+    assert len(world.contacts()) > 0
+    snapshot = world.save_snapshot()
+    assert isinstance(snapshot, bytes)
+    first = run(60)
+    world.restore_snapshot(snapshot)
+    again = run(60)
+    for a, b in zip(first[0], again[0]):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(first[1], again[1])
+    assert first[2] == again[2]
+    with pytest.raises(ValueError, match=r"snapshot of 3 bytes refused: not one this world's could have saved"):
+        world.restore_snapshot(b"abc")
+    with pytest.raises(ValueError, match="take at most"):
+        world.restore_snapshot(snapshot + bytes(10 ** 6))
+    with pytest.raises(ValueError, match="refused"):  # an instance's snapshot is not a world's
+        world.restore_snapshot(low.save_snapshot())
+
+
 def test_colliders_check_their_shape(free_model):
     with pytest.raises(ValueError, match="normal must not be zero"):
         quiver.Plane((0, 0, 0))

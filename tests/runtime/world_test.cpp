@@ -333,6 +333,87 @@ TEST(World, ASettledPileFallsAsleepWhereItRestsAndStaysThere) {
   EXPECT_LT(apart, 0.002);
 }
 
+// Everything of a world that a rewind must repeat: each instance's positions and whether it sleeps,
+// and the world's contacts, as bytes.
+std::vector<char> sceneOf(const World& world, const FreeBar& bar) {
+  std::vector<char> out;
+  const auto append = [&](const void* p, size_t n) { out.insert(out.end(), static_cast<const char*>(p), static_cast<const char*>(p) + n); };
+  for (const auto& b : world.bodies) {
+    std::vector<float> x(3 * bar.info.vertex_count);
+    qv_instance_positions(b->s, x.data());
+    append(x.data(), x.size() * sizeof(float));
+    const int sleeps = qv_instance_asleep(b->s);
+    append(&sleeps, sizeof sleeps);
+  }
+  const std::vector<qv_contact> contacts = world.contacts();
+  append(contacts.data(), contacts.size() * sizeof(qv_contact));
+  return out;
+}
+
+// A world's snapshot rewinds a pile of twenty bars settling and falling asleep bit for bit: their
+// positions, their sleep and their contacts; the same snapshot with its contacts left out (cold
+// starts) ends elsewhere. Restored and saved again, it is the same bytes. One another world could
+// not have saved is refused, the world unchanged.
+TEST(World, ASnapshotRewindsAPileSettlingAndFallingAsleepBitForBit) {
+  FreeBar bar(16, {6, 1, 1});
+  const double h = 1.0 / 60;
+  World world(0.5, 0, 4096, kSleepSpeed);
+  dropTwentyIntoABin(world, bar, h);
+  // Where a snapshot's parts are (quiver::rt::kContactRecord = 20 doubles a contact, 64 in an instance's).
+  const size_t state = qv_instance_snapshot_size(world.bodies[0]->s) / sizeof(double) - (1 + 20 * 64);
+  const size_t contactsAt = 1 + 20 * (3 + state);
+  for (int i = 0; i < 150; ++i) ASSERT_EQ(qv_world_step(world.w), 0);
+  ASSERT_EQ(asleep(world), 0);
+  std::vector<double> snapshot(qv_world_snapshot_size(world.w) / sizeof(double));
+  const size_t used = qv_world_save_snapshot(world.w, snapshot.data());
+  const size_t held = world.contacts().size();
+  ASSERT_GT(held, 40u);
+  ASSERT_EQ(snapshot[contactsAt], static_cast<double>(held));
+  const std::vector<char> saved = sceneOf(world, bar);
+  const auto run = [&](const std::vector<double>& from) {
+    EXPECT_EQ(qv_world_restore_snapshot(world.w, from.data(), used), QV_OK);
+    for (int i = 0; i < 240; ++i) EXPECT_EQ(qv_world_step(world.w), 0);
+    return sceneOf(world, bar);
+  };
+  const std::vector<char> first = run(snapshot);
+  ASSERT_EQ(asleep(world), 20) << "not all fell asleep in the steps rewound";
+  ASSERT_EQ(qv_world_restore_snapshot(world.w, snapshot.data(), used), QV_OK);
+  EXPECT_TRUE(sceneOf(world, bar) == saved);
+  EXPECT_TRUE(run(snapshot) == first);
+  std::printf("pile of 20: a world snapshot of %zu bytes (at most %zu) with %zu contacts rewound 4 s in which all fell asleep\n",
+              used, snapshot.size() * sizeof(double), held);
+  std::vector<double> cold = snapshot;
+  cold[contactsAt] = 0;
+  EXPECT_FALSE(run(cold) == first);
+  // Saved again once restored, the same bytes (the still times and sleep groups too); a sleeping
+  // pile woken and restored sleeps again.
+  std::vector<double> again(snapshot.size()), sleeping(snapshot.size());
+  const size_t asleepUsed = qv_world_save_snapshot(world.w, sleeping.data());
+  ASSERT_EQ(qv_world_restore_snapshot(world.w, snapshot.data(), used), QV_OK);
+  ASSERT_EQ(qv_world_save_snapshot(world.w, again.data()), used);
+  EXPECT_TRUE(std::equal(snapshot.begin(), snapshot.begin() + used / sizeof(double), again.begin()));
+  ASSERT_EQ(asleep(world), 0);
+  ASSERT_EQ(qv_world_restore_snapshot(world.w, sleeping.data(), asleepUsed), QV_OK);
+  EXPECT_EQ(asleep(world), 20);
+  // Refused: cut short, a sleep group that is no instance's, a contact on a vertex the model does
+  // not have, contacts out of order, a negative normal impulse, a world of another size.
+  const std::vector<char> now = sceneOf(world, bar);
+  EXPECT_EQ(qv_world_restore_snapshot(world.w, snapshot.data(), used - sizeof(double)), QV_ERROR_INVALID_ARGUMENT);
+  const auto refused = [&](size_t at, double value) {
+    std::vector<double> spoiled = snapshot;
+    spoiled[at] = value;
+    return qv_world_restore_snapshot(world.w, spoiled.data(), used) == QV_ERROR_INVALID_ARGUMENT;
+  };
+  EXPECT_TRUE(refused(1 + 2, 20));  // the first instance's sleep group
+  EXPECT_TRUE(refused(contactsAt + 1 + 3, bar.info.vertex_count));
+  EXPECT_TRUE(refused(contactsAt + 1, 19));
+  EXPECT_TRUE(refused(contactsAt + 1 + 11, -1));
+  EXPECT_TRUE(sceneOf(world, bar) == now);
+  World fewer(0.5, 0, 4096, kSleepSpeed);
+  fewer.add(bar, h, at(0, 0, 1), true);
+  EXPECT_EQ(qv_world_restore_snapshot(fewer.w, snapshot.data(), used), QV_ERROR_INVALID_ARGUMENT);
+}
+
 // Two bars crosswise on the ground (instances 0 and 1), stepped until both sleep.
 void laySleepingStack(World& world, const FreeBar& bar, double h) {
   world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0)};

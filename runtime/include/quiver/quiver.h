@@ -16,7 +16,7 @@ extern "C" {
 #endif
 
 #define QV_VERSION_MAJOR 0
-#define QV_VERSION_MINOR 14
+#define QV_VERSION_MINOR 15
 #define QV_VERSION_PATCH 0
 #define QV_VERSION_NUMBER (QV_VERSION_MAJOR * 10000 + QV_VERSION_MINOR * 100 + QV_VERSION_PATCH)
 
@@ -336,20 +336,25 @@ QV_API void qv_instance_set_state(qv_instance* instance, const double* q, const 
                                   const double* acceleration);
 
 /* Everything that evolves (q, velocity, acceleration, the solver's energy budget and its damping
-   stiffness, r (r + 1) / 2 values, and the last step's per-step forces, which the next step's
-   budget compares with) as an opaque block of qv_instance_snapshot_size() bytes, for rewinding,
-   replays and save games: restoring a snapshot and repeating the same calls repeats the same bits.
-   Restoring checks the size, that the snapshot came from a model of the same r, that its values
-   are finite (but for the last step's forces, where a step that reset may leave one that is not),
-   that a flying instance's orientation is not zero and that its damping stiffness is positive
-   definite (QV_ERROR_INVALID_ARGUMENT otherwise, the instance unchanged). A flying instance's
-   contacts are not in it: the next step's start cold (without the impulses the last step ended
-   with), so one in contact does not repeat its steps bit for bit. Restoring also restores whether a persistent load had changed since that step, so
-   set loads after restoring, as the calls being repeated would. The layout may change between runtime
-   versions (a flying instance's did after 0.13): the size check refuses another's. Saving uses the instance's scratch
-   (QV_SOLVER_NEWTON: it evaluates the state), so save one instance from one thread at a time. */
+   stiffness, r (r + 1) / 2 values, the last step's per-step forces, which the next step's budget
+   compares with, and in flight the pose, the momenta and the last step's contacts, from which the next
+   step's start) as an opaque block, for rewinding, replays and save games: restoring a snapshot and
+   repeating the same calls repeats the same bits, in contact too. qv_instance_snapshot_size() is the most
+   a snapshot takes (max_contacts contacts held); saving returns the bytes this one took, which is all
+   there is to keep (qv_instance_contacts reports the contacts it holds after restoring). Restoring takes
+   any size from those bytes to the most, and checks that the snapshot came from a model of the same r,
+   that its values are finite (but for the last step's forces, where a step that reset may leave one
+   that is not), that a flying instance's orientation is not zero, that its damping stiffness is
+   positive definite, and that its contacts are ones a step could have ended with (their vertices in the
+   model, normal impulses not negative, in the order a step leaves them): QV_ERROR_INVALID_ARGUMENT
+   otherwise, the instance unchanged. In a world, the world holds its instances' contacts and whether
+   they sleep: rewind it with qv_world_save_snapshot. Restoring also restores whether a persistent load
+   had changed since that step, so set loads after restoring, as the calls being repeated would. The
+   layout may change between runtime versions (a flying instance's did after 0.13 and 0.14): the checks
+   refuse most others'. Saving uses the instance's scratch (QV_SOLVER_NEWTON: it evaluates the state),
+   so save one instance from one thread at a time. */
 QV_API size_t qv_instance_snapshot_size(const qv_instance* instance);
-QV_API void qv_instance_save_snapshot(const qv_instance* instance, void* snapshot);
+QV_API size_t qv_instance_save_snapshot(const qv_instance* instance, void* snapshot);
 QV_API qv_result qv_instance_restore_snapshot(qv_instance* instance, const void* snapshot, size_t size);
 QV_API void qv_instance_reset(qv_instance* instance);
 QV_API void qv_instance_energies(const qv_instance* instance, double* kinetic, double* elastic);
@@ -475,6 +480,14 @@ QV_API void qv_instance_wake(qv_instance* instance);
 /* The last world step's contacts, as qv_instance_contacts (instance and other say who touched whom; the
    impulse is on `instance`, its opposite on `other`). */
 QV_API int qv_world_contacts(const qv_world* world, qv_contact* contacts, int capacity);
+/* A world's snapshot: each instance's (as qv_instance_save_snapshot), whether it sleeps and with whom,
+   and the last step's contacts between them all, for rewinding a scene (rollback, replays, save games):
+   restoring it and repeating the same calls repeats the same bits. The colliders are the caller's:
+   restore them too. Sizes, checks and threads as for an instance's snapshot; restoring also checks
+   that the world holds as many instances as it did, and changes nothing where a check fails. */
+QV_API size_t qv_world_snapshot_size(const qv_world* world);
+QV_API size_t qv_world_save_snapshot(const qv_world* world, void* snapshot);
+QV_API qv_result qv_world_restore_snapshot(qv_world* world, const void* snapshot, size_t size);
 
 /* Largest stable time step of central differences at rest, s: 2 / (c + sqrt(c^2 + omega_max^2)) for
    the stiffest mode of K(0), whose Rayleigh damping c = rayleigh_alpha + rayleigh_beta omega_max^2
