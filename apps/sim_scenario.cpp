@@ -38,10 +38,7 @@ void SimOptions::addScenarioTo(CLI::App& app) {
   app.add_flag("--free", step.freeFlight, "Fly: rigid motion with the deformation (a model baked with no fixed vertex)");
   app.add_flag("--soft-contacts", step.softContacts,
                "Free flight: contacts hold the deformed surface, which gives way where they push (soft objects rest flat)");
-  app.add_option("--max-substeps", step.maxSubsteps,
-                 "Free flight: the most substeps a fast spin's step is cut into, so that the body turns at most 0.75 rad in "
-                 "each (1: never cut; default 16)")
-      ->check(CLI::Range(1, 64));
+  addMaxSubstepsOption(app, step.maxSubsteps);
   flight.addTo(app);
   app.add_option("--dt", step.timeStep, "Time step, s")->check(TimeStep);
   app.add_option("--newton", step.newton,
@@ -116,7 +113,7 @@ ScenarioResult runScenario(ScenarioTarget& target, const TetMesh& mesh, const Si
   const std::vector<int> group = selectGroup(mesh, o.group);
   const bool dragMode = o.twist != 0 || o.drag != std::vector<double>{0, 0, 0};
   o.flight.check(o.step.freeFlight);
-  if (!o.step.freeFlight && o.step.maxSubsteps != 0) throw std::runtime_error("--max-substeps needs --free");
+  checkFlightSettings(o.step);
   if (o.step.freeFlight) target.startFlight(o);
   if (o.gravity) {
     const double g[3] = {0, 0, -kGravity};

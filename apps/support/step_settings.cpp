@@ -1,5 +1,6 @@
 #include "apps/support/step_settings.h"
 
+#include <stdexcept>
 #include <vector>
 
 namespace quiver::app {
@@ -59,6 +60,18 @@ CLI::Option* addElasticityOption(CLI::App& app, qv_elasticity& elasticity) {
 
 CLI::Option* addSolverOption(CLI::App& app, qv_solver& solver) {
   return addChoice(app, "--solver", solver, QV_SOLVER_COUNT, qv_solver_name, qv_solver_description, qv_solver_from_name);
+}
+
+CLI::Option* addMaxSubstepsOption(CLI::App& app, int& maxSubsteps) {
+  return app
+      .add_option("--max-substeps", maxSubsteps,
+                  "Free flight: the most substeps a fast spin's step is cut into, so that the body turns at most 0.75 rad "
+                  "in each (1: never cut; default 16)")
+      ->check(CLI::Range(1, 64));
+}
+
+void checkFlightSettings(const StepSettings& s) {
+  if (!s.freeFlight && s.maxSubsteps != 0) throw std::runtime_error("--max-substeps needs --free");
 }
 
 } // namespace quiver::app

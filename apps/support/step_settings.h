@@ -34,5 +34,9 @@ qv_instance_config instanceConfig(const qv_model* model, const StepSettings& set
 CLI::Option* addIntegratorOption(CLI::App& app, qv_integrator& integrator);
 CLI::Option* addElasticityOption(CLI::App& app, qv_elasticity& elasticity);
 CLI::Option* addSolverOption(CLI::App& app, qv_solver& solver);
+// --max-substeps (StepSettings::maxSubsteps), which only flight takes: checkFlightSettings().
+CLI::Option* addMaxSubstepsOption(CLI::App& app, int& maxSubsteps);
+// Refuses, saying why, what only flight takes without --free (the runtime would ignore it).
+void checkFlightSettings(const StepSettings& settings);
 
 } // namespace quiver::app

@@ -366,7 +366,11 @@ private:
       if (ImGui::InputDouble("damping beta, s", &beta, 0, 0, "%.4g", ImGuiInputTextFlags_EnterReturnsTrue))
         edited_.step.beta = std::max(beta, 0.0);
       ImGui::Checkbox("gravity", &edited_.gravity);
-      if (session_.flight()) ImGui::Checkbox("soft contacts", &edited_.step.softContacts);
+      if (session_.flight()) {
+        ImGui::Checkbox("soft contacts", &edited_.step.softContacts);
+        int substeps = session_.config().max_substeps;
+        if (ImGui::SliderInt("most substeps of a fast spin", &substeps, 1, 64)) edited_.step.maxSubsteps = substeps;
+      }
       float spring = static_cast<float>(edited_.springStiffness);
       if (ImGui::SliderFloat("mouse spring, N/m", &spring, 1e-3f * spring + 1e-9f, 1e3f * spring, "%.3g",
                              ImGuiSliderFlags_Logarithmic))
@@ -458,6 +462,7 @@ int main(int argc, char** argv) {
                "under it as baked, from one height above it");
   app.add_flag("--soft-contacts", o.settings.step.softContacts,
                "With --free: contacts hold the deformed surface, which gives way where they push (soft objects rest flat)");
+  addMaxSubstepsOption(app, o.settings.step.maxSubsteps);
   o.flight.addTo(app);
   app.add_option("--frames", o.frames, "Run this many frames (1/60 s of simulation each), then exit")
       ->check(Positive);
@@ -473,6 +478,7 @@ int main(int argc, char** argv) {
       throw std::runtime_error("--size must be two numbers between 64 and 8192");
     if (!o.screenshot.empty() && o.frames == 0) throw std::runtime_error("--screenshot needs --frames N");
     o.flight.check(o.settings.step.freeFlight);
+    checkFlightSettings(o.settings.step);
     if (o.settings.step.freeFlight && !o.showMode.empty()) throw std::runtime_error("--show-mode shows a model in place: not with --free");
     if (o.settings.step.freeFlight) o.settings.gravity = true;
     const RuntimeModel model(o.model);

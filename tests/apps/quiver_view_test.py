@@ -151,6 +151,11 @@ class QuiverView(unittest.TestCase):
         (soft, velocity), = self.bodies(p.stdout)
         self.assertAlmostEqual(soft[2], 0.05, delta=0.003)
         self.assertLess(np.linalg.norm(velocity), 0.01)
+        # Never cut into substeps (--max-substeps 1): a slow drop lands the same.
+        p = self.view("--free", "--max-substeps", 1, "--frames", 60, "--no-panel", model=FREE_MODEL)
+        (whole, velocity), = self.bodies(p.stdout)
+        self.assertAlmostEqual(whole[2], 0.05, delta=0.003)
+        self.assertLess(np.linalg.norm(velocity), 0.01)
 
     def test_bad_input_is_refused_without_a_screenshot(self):
         bad = os.path.join(self.tmp.name, "bad.txt")
@@ -162,7 +167,8 @@ class QuiverView(unittest.TestCase):
                               (["--show-mode", "linear:99"], "--show-mode linear:99"),
                               (["--show-mode", "sideways:1"], "expected linear:N or basis:N"),
                               (["--pile", 3], "need --free"), (["--free"], "was baked with fixed vertices"),
-                              (["--soft-contacts"], "--soft-contacts needs --free")):
+                              (["--soft-contacts"], "--soft-contacts needs --free"),
+                              (["--max-substeps", 4], "--max-substeps needs --free")):
             with self.subTest(args=args):
                 p = self.view("--frames", 5, "--screenshot", shot, *args)
                 self.assertEqual(p.returncode, 1, p.stderr)
