@@ -119,34 +119,37 @@ bool boxFacingDistance(const double p[3], const double e[3], const double facing
   return best < INFINITY;
 }
 
+// out = S w for the symmetric 3 x 3 S (row-major).
+void multiply3(const double S[9], const double w[3], double out[3]) {
+  for (int a = 0; a < 3; ++a) out[a] = S[3 * a] * w[0] + S[3 * a + 1] * w[1] + S[3 * a + 2] * w[2];
+}
+
 // 1 / (1/m + n . ((I^-1 (a x n)) x a)): the mass the impulse along n at arm a meets on one body.
 double inverseMass(const ContactBody& b, const double a[3], const double n[3]) {
   double an[3], ian[3], back[3];
   cross3(a, n, an);
-  b.instance->frame.inverseInertia(an, ian);
+  multiply3(b.inverseInertia, an, ian);
   cross3(ian, a, back);
   return 1.0 / b.instance->model->info.total_mass + dot3(n, back);
 }
 
-// The frame's velocity at a point with arm a, omega from the solve's current angular momentum.
+// The frame's velocity at a point with arm a, as the solve's impulses so far leave it.
 void bodyPointVelocity(const ContactBody& b, const double a[3], double out[3]) {
-  const RigidFrame& f = b.instance->frame;
-  double w[3], wa[3], dw[3];
-  const double dL[3] = {b.angularMomentum[0] - f.angularMomentum[0], b.angularMomentum[1] - f.angularMomentum[1],
-                        b.angularMomentum[2] - f.angularMomentum[2]};
-  f.inverseInertia(dL, dw);
-  for (int k = 0; k < 3; ++k) w[k] = b.omega[k] + dw[k];
-  cross3(w, a, wa);
+  double wa[3];
+  cross3(b.spin, a, wa);
   for (int k = 0; k < 3; ++k) out[k] = b.velocity[k] + wa[k];
 }
 
 void applyImpulse(ContactBody& b, const double a[3], const double J[3], double sign) {
-  double aj[3];
+  double aj[3], dw[3];
   cross3(a, J, aj);
+  for (int k = 0; k < 3; ++k) aj[k] *= sign;
+  multiply3(b.inverseInertia, aj, dw);
   const double mass = b.instance->model->info.total_mass;
   for (int k = 0; k < 3; ++k) {
     b.velocity[k] += sign * J[k] / mass;
-    b.angularMomentum[k] += sign * aj[k];
+    b.angularMomentum[k] += aj[k];
+    b.spin[k] += dw[k];
   }
 }
 
@@ -701,6 +704,8 @@ void takeMomenta(ContactBody* bodies, int count, const qv_collider* colliders, i
     std::memcpy(b.velocity, f.velocity, sizeof b.velocity);
     std::memcpy(b.angularMomentum, f.angularMomentum, sizeof b.angularMomentum);
     f.worldOmega(b.omega);
+    std::memcpy(b.spin, b.omega, sizeof b.spin);
+    f.inverseInertiaMatrix(b.inverseInertia);
   }
   spreadSpeeds(bodies, count, colliders, colliderCount, h, broad);
 }

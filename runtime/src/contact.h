@@ -44,6 +44,11 @@ struct ContactBody {
   qv_instance* instance = nullptr;
   double velocity[3] = {}, angularMomentum[3] = {};
   double omega[3] = {};  // the world angular velocity before the solve
+  // In the solve: the world angular velocity its impulses so far give (omega + I^-1 of the angular
+  // momentum they added), and the world inverse inertia they act through (RigidFrame's, held while
+  // the frame does not move), so that each impulse costs a product rather than a 3 x 3 solve.
+  double spin[3] = {};
+  double inverseInertia[9] = {};
   int firstPair = 0, pairEnd = 0;  // its pairs in the contact list
   // Its group: the bodies it could touch in the step (either stopped), and the ones those could
   // touch. The fastest relative speed of one of them against what it could touch sets its

@@ -368,6 +368,16 @@ void RigidFrame::inverseInertia(const double w[3], double out[3]) const {
   rotate(rotation, x, out);
 }
 
+void RigidFrame::inverseInertiaMatrix(double out[9]) const {
+  double bodyInverse[9], turned[9];  // I^-1, then I^-1 R^T
+  inverse3(inertia, bodyInverse);
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) turned[3 * a + b] = dot(bodyInverse + 3 * a, rotation + 3 * b, 3);
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      out[3 * a + b] = rotation[3 * a] * turned[b] + rotation[3 * a + 1] * turned[3 + b] + rotation[3 * a + 2] * turned[6 + b];
+}
+
 double RigidFrame::kineticEnergy(const qv_model& model) const {
   double spin = 0;
   for (int a = 0; a < 3; ++a) spin += bodyOmega[a] * (0.5 * dot(inertia + 3 * a, bodyOmega, 3) + internal[a]);

@@ -102,8 +102,10 @@ struct RigidFrame {
   // Body direction of world vector f: R^T f; and back, R v.
   void toBody(const double f[3], double out[3]) const;
   void toWorldDirection(const double v[3], double out[3]) const;
-  // The world's inverse inertia on w, R I^-1 R^T w (I of the last refresh()).
+  // The world's inverse inertia on w, R I^-1 R^T w (I of the last refresh()); and as a matrix
+  // (row-major, symmetric), for many products at one pose (a contact solve).
   void inverseInertia(const double w[3], double out[3]) const;
+  void inverseInertiaMatrix(double out[9]) const;
   // Kinetic energy of the frame's motion and its coupling to q': m |v|^2 / 2 + omega . (I omega / 2
   // + h) (refresh() first); with |q'|^2 / 2 the body's whole kinetic energy.
   double kineticEnergy(const qv_model& model) const;

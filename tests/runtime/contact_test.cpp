@@ -248,6 +248,25 @@ TEST(Contact, ASnapshotTakenInContactRewindsBitForBit) {
   EXPECT_TRUE(contacts() == saved);
 }
 
+// The contact solve's impulses act through the frame's world inverse inertia as one matrix
+// (RigidFrame::inverseInertiaMatrix()): for a deformed, turned bar it inverts R I(q) R^T, built
+// here from I(q) and R themselves, and is symmetric.
+TEST(Contact, TheSolvesInverseInertiaInvertsTheWorldInertia) {
+  Dropped d(1.0 / 60, {}, {{0, 0, 1}, {0.96, 0.1, 0.2, 0.15}, {0, 0, 0}, {1, 2, 3}});
+  std::vector<double> q(d.bar.info.r, 0.0);
+  for (size_t i = 0; i < q.size(); ++i) q[i] = 0.02 * std::cos(1.0 + i);
+  qv_instance_set_state(d.inst->s, q.data(), nullptr, nullptr);
+  const rt::RigidFrame& f = d.inst->s->frame;
+  const Eigen::Matrix3d R = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(f.rotation);
+  const Eigen::Matrix3d I = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(f.inertia);
+  double m[9];
+  f.inverseInertiaMatrix(m);
+  const Eigen::Matrix3d inverse = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(m);
+  EXPECT_LT((inverse * R * I * R.transpose() - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+  EXPECT_LT((inverse - inverse.transpose()).norm(), 1e-12 * inverse.norm());
+  EXPECT_GT((I - I.trace() / 3 * Eigen::Matrix3d::Identity()).norm(), 0.1 * I.norm());  // not round: R matters
+}
+
 TEST(Contact, BadCollidersAndGroundedInstancesAreRefused) {
   FreeBar bar;
   test::Instance flying(bar.model, bar.config(1.0 / 60));
