@@ -78,7 +78,7 @@ void restoreSnapshot(const py::bytes& snapshot, const std::string& whose, size_t
   std::vector<double> aligned(bytes.size() / sizeof(double) + 1);
   std::memcpy(aligned.data(), bytes.data(), bytes.size());
   require(restore(aligned.data(), bytes.size()) == QV_OK,
-          size + " refused: not one " + whose + " could have saved (cut short, another model's r or another membership, a "
+          size + " refused: not one " + whose + " could have saved (cut short, another model's r, a world of another size, a "
           "value not finite, a damping stiffness not positive definite, or contacts no step could have ended with)");
 }
 

@@ -119,7 +119,7 @@ bool boxFacingDistance(const double p[3], const double e[3], const double facing
   return best < INFINITY;
 }
 
-// out = S w for the symmetric 3 x 3 S (row-major).
+// out = S w for a 3 x 3 S (row-major).
 void multiply3(const double S[9], const double w[3], double out[3]) {
   for (int a = 0; a < 3; ++a) out[a] = S[3 * a] * w[0] + S[3 * a + 1] * w[1] + S[3 * a + 2] * w[2];
 }

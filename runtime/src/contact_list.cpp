@@ -9,11 +9,6 @@ namespace quiver::rt {
 
 namespace {
 
-// x as an index in [low, high), or -2 (no index) where it is not one.
-int indexIn(double x, int low, int high) {
-  return x >= low && x < high && x == std::floor(x) ? static_cast<int>(x) : -2;
-}
-
 Contact recordOf(const double* in) {
   Contact c;
   c.body = static_cast<int>(in[0]);
@@ -49,8 +44,11 @@ size_t saveContacts(const ContactList& list, double* out) {
   return 1 + kContactRecord * static_cast<size_t>(list.count);
 }
 
+// Whether v[0, 3) has length 1 (to rounding, as the solve leaves normals and tangents).
+bool unit(const double* v) { return std::fabs(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] - 1) <= 1e-9; }
+
 size_t validContacts(const double* in, size_t available, const ContactList& list, const qv_instance* const* bodies,
-                     int bodyCount) {
+                     int bodyCount, int colliderCount) {
   if (available < 1) return 0;
   const int count = indexIn(in[0], 0, list.capacity + 1);
   if (count < 0 || available - 1 < kContactRecord * static_cast<size_t>(count)) return 0;
@@ -58,12 +56,13 @@ size_t validContacts(const double* in, size_t available, const ContactList& list
   for (int j = 0; j < count; ++j) {
     const double* r = in + 1 + kContactRecord * static_cast<size_t>(j);
     if (!std::all_of(r, r + kContactRecord, [](double x) { return std::isfinite(x); }) || !(r[11] >= 0)) return 0;
+    if (!unit(r + 7) || !unit(r + 14) || !unit(r + 17)) return 0;
     const int body = indexIn(r[0], 0, bodyCount), other = indexIn(r[1], -1, bodyCount);
-    const int collider = indexIn(r[2], -1, INT32_MAX);
+    const int collider = indexIn(r[2], -1, colliderCount);
     if (body < 0 || other < -1 || other == body || (other >= 0) != (collider == -1) || collider < -1) return 0;
     if (indexIn(r[3], 0, bodies[body]->model->info.vertex_count) < 0) return 0;
     const Contact c = recordOf(r);
-    if (j > 0 && keyBefore(c, last)) return 0;  // the warm start looks them up in this order
+    if (j > 0 && !keyBefore(last, c)) return 0;  // the warm start looks them up in this order
     last = c;
   }
   return 1 + kContactRecord * static_cast<size_t>(count);

@@ -80,11 +80,16 @@ constexpr size_t kContactRecord = 20;
 // Writes the count and the records; returns the doubles written.
 size_t saveContacts(const ContactList& list, double* out);
 // How many doubles the contacts at `in` take (their count and records), or 0 where they are not a
-// list a step of `bodies` (their indices' order) could have ended with: the count within the
-// list's capacity and the `available` doubles, each record finite, of a body and its vertex, and
-// another body or a collider, with a non-negative normal impulse, in the solve's order.
+// list a step of `bodies` (their indices' order) among `colliderCount` colliders could have ended
+// with: the count within the list's capacity and the `available` doubles, each record finite, of a
+// body and its vertex, and another body or a collider, with unit normal and tangents and a
+// non-negative normal impulse, in the solve's order (no key twice).
 size_t validContacts(const double* in, size_t available, const ContactList& list, const qv_instance* const* bodies,
-                     int bodyCount);
+                     int bodyCount, int colliderCount);
+// x as an index in [low, high) (a number a snapshot holds), or -2 where it is not one.
+inline int indexIn(double x, int low, int high) {
+  return x >= low && x < high && x == static_cast<double>(static_cast<long long>(x)) ? static_cast<int>(x) : -2;
+}
 // Makes them the last step's (validContacts() first).
 void restoreContacts(ContactList& list, const double* in);
 

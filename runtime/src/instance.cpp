@@ -431,7 +431,9 @@ void qv_instance::saveState(double* out) const {
     std::memcpy(f + 7, frame.velocity, 3 * sizeof(double));
     std::memcpy(f + 10, frame.angularMomentum, 3 * sizeof(double));
     f[13] = frame.turnCredit;
-    f += 14;
+    std::memcpy(f + 14, frame.homePosition, 3 * sizeof(double));
+    std::memcpy(f + 17, frame.homeOrientation, 4 * sizeof(double));
+    f += 21;
   }
   // D, likewise: the minimiser's, or the one it would start from here. Written, not recomputed on
   // restoring: a group evaluates K(q) in a different order than one instance does, so only the
@@ -459,9 +461,12 @@ bool qv_instance::validState(const double* in) const {
   const size_t lastForces = 3 + 3 * static_cast<size_t>(r) + frameSnapshotSize() + static_cast<size_t>(r) * (r + 1) / 2;
   for (size_t i = 1; i < stateSize(); ++i)
     if ((i < lastForces || i >= lastForces + r) && !std::isfinite(in[i])) return false;
-  if (flying()) {  // an orientation of length 0 (crafted) turns nothing
-    const double* o = in + 3 + 3 * r + 3;
-    if (!(o[0] * o[0] + o[1] * o[1] + o[2] * o[2] + o[3] * o[3] > 0)) return false;
+  if (flying()) {  // orientations (the frame's, the home pose's) of length 0 or beyond range (crafted) turn nothing
+    for (const size_t at : {size_t{3}, size_t{17}}) {
+      const double* o = in + 3 + 3 * r + at;
+      const double length2 = o[0] * o[0] + o[1] * o[1] + o[2] * o[2] + o[3] * o[3];
+      if (!(length2 > 0 && length2 < INFINITY)) return false;
+    }
   }
   // D must be positive definite, or the damping would add energy.
   const double* savedD = in + 3 + 3 * r + frameSnapshotSize();
@@ -498,6 +503,12 @@ void qv_instance::restoreState(const double* in) {
     std::memcpy(frame.velocity, f + 7, 3 * sizeof(double));
     std::memcpy(frame.angularMomentum, f + 10, 3 * sizeof(double));
     frame.turnCredit = f[13];  // finite, as checked above; negative: a debt
+    // The pose a reset goes to (goHome() normalises its orientation).
+    std::memcpy(frame.homePosition, f + 14, 3 * sizeof(double));
+    std::memcpy(frame.homeOrientation, f + 17, 4 * sizeof(double));
+    // What the frame derives from the state, which a step refreshes at its start but a world's
+    // sleepers are read with unstepped (their spin and inertia decide who can touch them).
+    frame.refresh(*model, q, v);
   }
 }
 
@@ -510,8 +521,8 @@ bool qv_instance::restoreSnapshot(const double* in, size_t bytes) {
   const size_t available = bytes / sizeof(double);
   if (bytes > snapshotSize() || available < stateSize() || !validState(in)) return false;
   const qv_instance* self = this;
-  const size_t held = flying() ? quiver::rt::validContacts(in + stateSize(), available - stateSize(), contacts, &self, 1) : 0;
-  if (flying() && !held) return false;
+  if (flying() && !quiver::rt::validContacts(in + stateSize(), available - stateSize(), contacts, &self, 1, colliderCount))
+    return false;
   restoreState(in);
   // Its contacts, which the next step warm-starts from; a world's members keep theirs in the world.
   if (flying()) quiver::rt::restoreContacts(contacts, in + stateSize());

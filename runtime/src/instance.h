@@ -176,7 +176,7 @@ struct qv_instance {
   void takeOutTurnExcess(bool betweenSubsteps);
   // The snapshot: its state, then in flight the last step's contacts (contact_list.h). The state:
   // r, then q, v, a, E(q) and the energy slack, then in flight the frame (position, orientation,
-  // velocity, angular momentum, turn credit), then D's upper triangle row by row, then the last
+  // velocity, angular momentum, turn credit, and the home pose: position, orientation), then D's upper triangle row by row, then the last
   // step's per-step forces and whether a persistent load changed since (1 or 0), then the fixed
   // Newton account (the elastic allowance, the previous E(q) and q, the exact end checks left), as
   // doubles: all a step reads beyond the caller's calls. A world's snapshot (world.h) holds its
@@ -185,7 +185,7 @@ struct qv_instance {
     const size_t n = static_cast<size_t>(r);
     return 3 * n + 3 + frameSnapshotSize() + n * (n + 1) / 2 + 2 * n + 4;
   }
-  size_t frameSnapshotSize() const { return flying() ? 14 : 0; }
+  size_t frameSnapshotSize() const { return flying() ? 21 : 0; }
   void saveState(double* out) const;
   bool validState(const double* in) const;  // checks D in the scratch: one thread at a time
   void restoreState(const double* in);      // validState() first

@@ -161,11 +161,11 @@ bool qv_world::restoreSnapshot(const double* in, size_t bytes) {
     if (available < at + 3 + s.stateSize()) return false;
     const double* sleep = in + at;
     if ((sleep[0] != 0 && sleep[0] != 1) || !(sleep[1] >= 0 && sleep[1] < INFINITY) ||
-        !(sleep[2] >= -1 && sleep[2] < count && sleep[2] == std::floor(sleep[2])) || !s.validState(sleep + 3))
+        quiver::rt::indexIn(sleep[2], -1, count) < -1 || !s.validState(sleep + 3))
       return false;
     at += 3 + s.stateSize();
   }
-  if (!quiver::rt::validContacts(in + at, available - at, contacts, instances, count)) return false;
+  if (!quiver::rt::validContacts(in + at, available - at, contacts, instances, count, colliderCount)) return false;
   at = 1;
   for (int i = 0; i < count; ++i) {
     qv_instance& s = *instances[i];

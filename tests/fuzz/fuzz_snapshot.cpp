@@ -4,9 +4,9 @@
 // is saved in contact. Each input is then restored four ways: as it is, as an instance's and as a
 // world's snapshot, and as edits to the saved ones (12 bytes an edit: a little-endian word index,
 // taken modulo the snapshot's words, and the double to put there), so that mutations reach the
-// checks behind the size and the state's. A refused snapshot must leave the instance or world as it
-// was (saved again, the same bytes); an accepted one is stepped, and must step without a sanitizer
-// report and leave a finite state or reset.
+// checks behind the size and the state's. Each input starts from the saved snapshots. A refused
+// snapshot must leave the instance or world as it was (saved again, the same bytes); an accepted
+// one is stepped, and must step without a sanitizer report and leave a finite state or reset.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -137,6 +137,10 @@ void restore(Scene& s, bool world, const std::vector<double>& bytesAligned, size
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   Scene& s = scene();
+  // Each input from the same start, so that a crash repeats from its input alone.
+  if (qv_instance_restore_snapshot(s.alone, s.aloneSaved.data(), s.aloneSaved.size() * sizeof(double)) != QV_OK ||
+      qv_world_restore_snapshot(s.world, s.worldSaved.data(), s.worldSaved.size() * sizeof(double)) != QV_OK)
+    std::abort();
   std::vector<double> raw(size / sizeof(double) + 1);
   if (size) std::memcpy(raw.data(), data, size);
   restore(s, false, raw, size);

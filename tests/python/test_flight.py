@@ -181,7 +181,7 @@ def test_a_world_snapshot_rewinds_a_stack_landing_bit_for_bit(free_model):
         return [s.positions() for s in world.instances], world.contacts(), [s.asleep for s in world.instances]
 
     run(20)  # the upper is landing on the lower
-    assert len(world.contacts()) > 0
+    assert (world.contacts()["other"] >= 0).any()
     snapshot = world.save_snapshot()
     assert isinstance(snapshot, bytes)
     first = run(60)

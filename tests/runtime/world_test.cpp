@@ -385,9 +385,10 @@ TEST(World, ASnapshotRewindsAPileSettlingAndFallingAsleepBitForBit) {
   std::vector<double> cold = snapshot;
   cold[contactsAt] = 0;
   EXPECT_FALSE(run(cold) == first);
-  // Saved again once restored, the same bytes (the still times and sleep groups too); a sleeping
-  // pile woken and restored sleeps again.
+  // Saved again once restored, the same bytes (the still times and sleep groups too); the pile
+  // asleep (after the cold run), restored over an awake one, sleeps again.
   std::vector<double> again(snapshot.size()), sleeping(snapshot.size());
+  ASSERT_EQ(asleep(world), 20) << "the cold run did not fall asleep";
   const size_t asleepUsed = qv_world_save_snapshot(world.w, sleeping.data());
   ASSERT_EQ(qv_world_restore_snapshot(world.w, snapshot.data(), used), QV_OK);
   ASSERT_EQ(qv_world_save_snapshot(world.w, again.data()), used);
@@ -445,6 +446,33 @@ TEST(World, ABarDroppedOnASleepingStackWakesItAndLandsOnIt) {
               woke ? "yes" : "no", top);
   EXPECT_TRUE(woke);
   EXPECT_NEAR(top, 0.25, 0.01);
+}
+
+// A snapshot taken while a stack sleeps and a bar falls onto it rewinds bit for bit, though the
+// sleepers moved since: woken by the bar, and one given a fast spin by the caller. A sleeper is not
+// stepped, yet its spin decides who can reach it, so restoring must bring it up to date with the
+// restored state (it was that of the last motion: the stack then woke at once).
+TEST(World, ASnapshotWithSleepersRewindsBitForBitAfterTheyMoved) {
+  FreeBar bar(16, {12, 2, 2});
+  const double h = 1.0 / 60;
+  World world(0.5, 0, 4096, kSleepSpeed);
+  laySleepingStack(world, bar, h);
+  ASSERT_FALSE(HasFatalFailure());
+  world.add(bar, h, at(0.3, 0.05, 1.2), true);  // beyond reach of the stack's bounding spheres at first
+  std::vector<double> snapshot(qv_world_snapshot_size(world.w) / sizeof(double));
+  const size_t used = qv_world_save_snapshot(world.w, snapshot.data());
+  const auto landing = [&] {
+    for (int i = 0; i < 90; ++i) EXPECT_EQ(qv_world_step(world.w), 0);
+    return sceneOf(world, bar);
+  };
+  const std::vector<char> first = landing();
+  ASSERT_LT(asleep(world), 2) << "the stack never woke";
+  const qv_rigid_state spun = {{0.3, 0.05, 0.3}, {1, 0, 0, 0}, {0, 0, 0}, {200, 0, 50}};
+  ASSERT_EQ(qv_instance_set_rigid_state(world.bodies[0]->s, &spun), QV_OK);
+  ASSERT_EQ(qv_world_step(world.w), 0);
+  ASSERT_EQ(qv_world_restore_snapshot(world.w, snapshot.data(), used), QV_OK);
+  EXPECT_EQ(asleep(world), 2);
+  EXPECT_TRUE(landing() == first);
 }
 
 // A bar asleep on a box (a platform, the caller moving it with a velocity) wakes when the platform

@@ -337,8 +337,8 @@ QV_API void qv_instance_set_state(qv_instance* instance, const double* q, const 
 
 /* Everything that evolves (q, velocity, acceleration, the solver's energy budget and its damping
    stiffness, r (r + 1) / 2 values, the last step's per-step forces, which the next step's budget
-   compares with, and in flight the pose, the momenta and the last step's contacts, from which the next
-   step's start) as an opaque block, for rewinding, replays and save games: restoring a snapshot and
+   compares with, and in flight the pose, the momenta, the pose a reset goes to and the last step's
+   contacts, from which the next step's start) as an opaque block, for rewinding, replays and save games: restoring a snapshot and
    repeating the same calls repeats the same bits, in contact too. qv_instance_snapshot_size() is the most
    a snapshot takes (max_contacts contacts held); saving returns the bytes this one took, which is all
    there is to keep (qv_instance_contacts reports the contacts it holds after restoring). Restoring takes
@@ -346,8 +346,9 @@ QV_API void qv_instance_set_state(qv_instance* instance, const double* q, const 
    that its values are finite (but for the last step's forces, where a step that reset may leave one
    that is not), that a flying instance's orientation is not zero, that its damping stiffness is
    positive definite, and that its contacts are ones a step could have ended with (their vertices in the
-   model, normal impulses not negative, in the order a step leaves them): QV_ERROR_INVALID_ARGUMENT
-   otherwise, the instance unchanged. In a world, the world holds its instances' contacts and whether
+   model, their colliders among those set now (set the colliders first), unit normals, normal impulses
+   not negative, in the order a step leaves them): QV_ERROR_INVALID_ARGUMENT otherwise, the instance
+   unchanged. In a world, the world holds its instances' contacts and whether
    they sleep: rewind it with qv_world_save_snapshot. Restoring also restores whether a persistent load
    had changed since that step, so set loads after restoring, as the calls being repeated would. The
    layout may change between runtime versions (a flying instance's did after 0.13 and 0.14): the checks
