@@ -69,6 +69,13 @@ void require(bool ok, const std::string& message) {
   if (!ok) throw py::value_error(message);
 }
 
+// What save(data) writes into `most` bytes (8-byte aligned, as the C API wants), as the bytes it used.
+template <class Save>
+py::bytes saveSnapshot(size_t most, Save save) {
+  std::vector<double> aligned(most / sizeof(double) + 1);
+  return py::bytes(reinterpret_cast<const char*>(aligned.data()), save(aligned.data()));
+}
+
 // Restores `snapshot` with restore(data, size) (8-byte aligned, as the C API wants), or raises.
 template <class Restore>
 void restoreSnapshot(const py::bytes& snapshot, const std::string& whose, size_t most, Restore restore) {
@@ -372,9 +379,7 @@ rest), the worst of the steps taken; last_step describes the last.)")
         return py::make_tuple(kinetic, elastic);
       }, "(kinetic, elastic) energy in J")
       .def("save_snapshot", [](const Instance& self) {
-        std::string bytes(qv_instance_snapshot_size(self.use()), '\0');
-        bytes.resize(qv_instance_save_snapshot(self.use(), bytes.data()));
-        return py::bytes(bytes);
+        return saveSnapshot(qv_instance_snapshot_size(self.use()), [&](void* data) { return qv_instance_save_snapshot(self.use(), data); });
       }, "Everything that evolves (in flight its contacts too), as bytes: restoring them and repeating the same calls "
          "repeats the same bits.")
       .def("restore_snapshot", [](Instance& self, const py::bytes& snapshot) {
@@ -550,9 +555,7 @@ and returns how many reset. The world keeps its instances alive.)")
       .def("contacts", [](const World& self) { return contactArray(static_cast<const qv_world*>(self.use()), qv_world_contacts); },
            "The last step's contacts, as Instance.contacts(); `instance` and `other` say who touched whom.")
       .def("save_snapshot", [](const World& self) {
-        std::string bytes(qv_world_snapshot_size(self.use()), '\0');
-        bytes.resize(qv_world_save_snapshot(self.use(), bytes.data()));
-        return py::bytes(bytes);
+        return saveSnapshot(qv_world_snapshot_size(self.use()), [&](void* data) { return qv_world_save_snapshot(self.use(), data); });
       }, "Every instance's snapshot, whether it sleeps, and the contacts between them, as bytes: restoring them and "
          "repeating the same calls repeats the same bits (the colliders are the caller's to restore).")
       .def("restore_snapshot", [](World& self, const py::bytes& snapshot) {

@@ -427,15 +427,19 @@ void laySleepingStack(World& world, const FreeBar& bar, double h) {
   ASSERT_EQ(asleep(world), 2);
 }
 
+// laySleepingStack(), and a third bar above it at `height` (instance 2), falling.
+void laySleepingStackUnderABar(World& world, const FreeBar& bar, double h, double height) {
+  laySleepingStack(world, bar, h);
+  if (!::testing::Test::HasFatalFailure()) world.add(bar, h, at(0.3, 0.05, height), true);
+}
+
 // A third bar dropped from 0.3 m above a sleeping stack must wake it and land on it, not pass
 // through the sleepers (their contacts are not sought while they sleep).
 TEST(World, ABarDroppedOnASleepingStackWakesItAndLandsOnIt) {
   FreeBar bar(16, {12, 2, 2});
-  const double h = 1.0 / 60;
   World world(0.5, 0, 4096, kSleepSpeed);
-  laySleepingStack(world, bar, h);
+  laySleepingStackUnderABar(world, bar, 1.0 / 60, 0.55);
   ASSERT_FALSE(HasFatalFailure());
-  world.add(bar, h, at(0.3, 0.05, 0.55), true);
   bool woke = false;
   for (int i = 0; i < 180; ++i) {
     ASSERT_EQ(qv_world_step(world.w), 0);
@@ -454,11 +458,9 @@ TEST(World, ABarDroppedOnASleepingStackWakesItAndLandsOnIt) {
 // restored state (it was that of the last motion: the stack then woke at once).
 TEST(World, ASnapshotWithSleepersRewindsBitForBitAfterTheyMoved) {
   FreeBar bar(16, {12, 2, 2});
-  const double h = 1.0 / 60;
   World world(0.5, 0, 4096, kSleepSpeed);
-  laySleepingStack(world, bar, h);
+  laySleepingStackUnderABar(world, bar, 1.0 / 60, 1.2);  // beyond reach of the stack's bounding spheres at first
   ASSERT_FALSE(HasFatalFailure());
-  world.add(bar, h, at(0.3, 0.05, 1.2), true);  // beyond reach of the stack's bounding spheres at first
   std::vector<double> snapshot(qv_world_snapshot_size(world.w) / sizeof(double));
   const size_t used = qv_world_save_snapshot(world.w, snapshot.data());
   const auto landing = [&] {
