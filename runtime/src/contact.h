@@ -49,6 +49,11 @@ struct ContactBody {
   // the frame does not move), so that each impulse costs a product rather than a 3 x 3 solve.
   double spin[3] = {};
   double inverseInertia[9] = {};
+  // In the solve: the island it is in (the lowest index of the bodies its contacts join), and at an
+  // island's index whether one of its contacts bounces, whether the last sweep moved its impulses,
+  // and whether it has settled (no more sweeps).
+  int island = 0;
+  bool islandBounces = false, islandMoved = false, islandSettled = false;
   int firstPair = 0, pairEnd = 0;  // its pairs in the contact list
   // Its group: the bodies it could touch in the step (either stopped), and the ones those could
   // touch. The fastest relative speed of one of them against what it could touch sets its
