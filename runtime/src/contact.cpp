@@ -16,10 +16,10 @@ namespace {
 constexpr double kSoftness = 0.1;
 constexpr int kSweeps = 24;  // at most
 // A sweep that changes none of an island's impulses by more than this fraction of what resting
-// takes (restingImpulse) ends the island's solve: the sweeps left would move its bodies by less
-// than about 1e-8 m/s. At rest the warm start leaves 1e-16 (a bar alone) to 1e-7 (in a pile of 80)
-// for the first sweep, which then shrinks by a tenth or less each sweep; a landing or a slide
-// changes them by whole fractions and takes all the sweeps.
+// takes (restingImpulse) ends the island's solve: such a sweep moved its contacts by about 1e-8 m/s
+// each. At rest the warm start leaves 1e-16 (a bar alone) to 1e-7 (in a pile of 80) for the first
+// sweep, which later sweeps shrink by 10% or less each; a landing or a slide changes them by
+// whole fractions and takes all the sweeps.
 constexpr double kConverged = 1e-8;
 constexpr double kMaxPushOut = 1.0;  // m/s: the fastest a deep penetration is pushed out
 // rad: past this turn in a step, a vertex's straight path strays from its arc by an eighth of its

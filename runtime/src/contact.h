@@ -14,7 +14,8 @@
 // - a vertex deeper than resting contacts sink (spawned or pushed deep inside) takes whichever face
 //   is nearest, so each pair keeps only its deep contacts that push along the pair's mean push
 //   (opposed pushes grew without bound and flung the bodies off);
-// - sequential impulses (24 sweeps) on the frames' velocities and angular momenta: a normal impulse
+// - sequential impulses (24 sweeps at most, an island of bodies stopping once its impulses settle)
+//   on the frames' velocities and angular momenta: a normal impulse
 //   >= 0 that stops the approach where the surfaces meet (so nothing tunnels while it is seen) and
 //   pushes out what penetrates beyond a slop (at 1 m/s at most), slightly soft so that a resting face shares its weight
 //   by depth; from the middle sweep on, contacts that push aim at the bounce (restitution x the
