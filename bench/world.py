@@ -11,7 +11,14 @@ rigid shapes (the default) and with soft contacts (`--soft-contacts`: on their d
 which give way where they push).
 
     /usr/bin/python3 bench/world.py --build build/release [--piles 20,80,320] [--spread 1024] [--contacts rigid,soft]
+
+With --against QUIVER (another build's `quiver`, e.g. one built at an earlier commit), compares the
+two instead, kept awake (`--sleep-speed 0`), rigid contacts: each pile, the spread and one bar
+resting alone (no world), --runs alternated runs of --steps steps each, their medians and ratio.
+
+    /usr/bin/python3 bench/world.py --build build/release --against /tmp/quiver_before [--runs 3] [--steps 600]
 """
+import statistics
 import argparse
 import json
 import os
@@ -30,6 +37,9 @@ def main():
     ap.add_argument("--piles", default="20,80,320")
     ap.add_argument("--spread", type=int, default=1024)
     ap.add_argument("--contacts", default="rigid,soft", help="comma-separated: rigid (the default contacts), soft")
+    ap.add_argument("--against", help="another build's quiver binary: compare the two (see above)")
+    ap.add_argument("--runs", type=int, default=3, help="with --against: alternated runs of each")
+    ap.add_argument("--steps", type=int, default=STEPS, help="steps of 1/60 s a run")
     args = ap.parse_args()
     if not set(args.contacts.split(",")) <= {"rigid", "soft"}:
         ap.error(f"--contacts: expected rigid, soft or rigid,soft, not '{args.contacts}'")
@@ -42,19 +52,21 @@ def main():
         subprocess.run(["mpirun", "-n", "2", os.path.join(apps, "quiver-bake"), mesh, "--modes", "10", "--rank", "16",
                         "--quiet", "-o", bar], check=True, env=ENV, stdin=subprocess.DEVNULL, capture_output=True)
         worlds = [(int(x), []) for x in args.piles.split(",")] + [(args.spread, ["--spread"])]
+        if args.against:
+            return compare(args, bar + ".qvr", os.path.join(apps, "quiver"), worlds)
         for n, layout in worlds:
             for contacts in args.contacts.split(","):
                 for sleep in ("0", "0.02"):
                     soft = ["--soft-contacts"] if contacts == "soft" else []
                     sim = subprocess.run([os.path.join(apps, "quiver"), "sim", bar + ".qvr", "--free", "--gravity", "--pile", str(n),
                                           *layout, *soft, "--position", "0,0,0.2", "--collider", "plane:0,0,1,0",
-                                          "--steps", str(STEPS), "--sleep-speed", sleep, "--json"],
+                                          "--steps", str(args.steps), "--sleep-speed", sleep, "--json"],
                                          capture_output=True, text=True, stdin=subprocess.DEVNULL)
                     if sim.returncode not in (0, 2):  # 2: some step reset, which the table counts
                         raise SystemExit(f"quiver sim --pile {n} failed ({sim.returncode}): {sim.stderr.strip()}")
                     rows.append((f"{n} apart" if layout else str(n), contacts, "off" if sleep == "0" else f"{sleep} m/s",
                                  json.loads(sim.stdout)))
-    print(machine_line() + f"; one thread, {STEPS} steps of 1/60 s\n")
+    print(machine_line() + f"; one thread, {args.steps} steps of 1/60 s\n")
     print("| bodies | contacts | sleeping | world step, median (ms) | 99th percentile (ms) | median per body (us) "
           "| asleep at the end | fastest body at the end (m/s) | deepest deformed-vertex penetration (mm) | resets |")
     print("|---:|---|---|---:|---:|---:|---:|---:|---:|---:|")
@@ -63,6 +75,27 @@ def main():
         print(f"| {n} | {contacts} | {sleep} | {j['step_us_median'] / 1e3:.2f} | {j['step_us_p99'] / 1e3:.1f} | {j['step_us_median'] / bodies:.1f} "
               f"| {j['asleep_at_end']} | {j['max_final_speed_mps']:.1g} "
               f"| {j['max_penetration_m'] * 1e3:.0f} | {j['resets']} |")
+
+
+def compare(args, model, quiver, worlds):
+    """--against: each world (awake, rigid contacts) and one bar alone, both builds alternated."""
+    cases = [(f"{n} apart" if layout else f"pile of {n}", ["--pile", str(n), *layout, "--sleep-speed", "0"])
+             for n, layout in worlds] + [("one bar alone", [])]
+    print(machine_line() + f"; one thread, {args.steps} steps of 1/60 s, {args.runs} alternated runs each, medians\n")
+    print(f"| world | {args.against} (ms) | {quiver} (ms) | ratio |")
+    print("|---|---:|---:|---:|")
+    for name, options in cases:
+        times = {args.against: [], quiver: []}
+        for _ in range(args.runs):
+            for binary in times:
+                sim = subprocess.run([binary, "sim", model, "--free", "--gravity", *options, "--position", "0,0,0.2",
+                                      "--collider", "plane:0,0,1,0", "--steps", str(args.steps), "--json"],
+                                     capture_output=True, text=True, stdin=subprocess.DEVNULL)
+                if sim.returncode not in (0, 2):
+                    raise SystemExit(f"{binary} sim ({name}) failed ({sim.returncode}): {sim.stderr.strip()}")
+                times[binary].append(json.loads(sim.stdout)["step_us_median"] / 1e3)
+        before, after = statistics.median(times[args.against]), statistics.median(times[quiver])
+        print(f"| {name} | {before:.3f} | {after:.3f} | {after / before:.2f} |")
 
 
 if __name__ == "__main__":
