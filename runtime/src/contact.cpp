@@ -8,6 +8,7 @@
 
 #include "c_enum.h"
 #include "triangle_mesh.h"
+#include "vec3.h"
 
 namespace quiver::rt {
 
@@ -31,15 +32,6 @@ constexpr double kMaxPushOut = 1.0;  // m/s: the fastest a deep penetration is p
 // only where the centre's distance, less the arm and that relative travel (twice over the step, as
 // the margins take it), can close.
 constexpr double kStraightTurn = 0.5;
-
-double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double norm3(const double a[3]) { return std::sqrt(dot3(a, a)); }
-
-void cross3(const double a[3], const double b[3], double out[3]) {
-  out[0] = a[1] * b[2] - a[2] * b[1];
-  out[1] = a[2] * b[0] - a[0] * b[2];
-  out[2] = a[0] * b[1] - a[1] * b[0];
-}
 
 bool finiteAll(const double* v, int n) {
   for (int i = 0; i < n; ++i)
@@ -123,11 +115,6 @@ bool boxFacingDistance(const double p[3], const double e[3], const double facing
       for (int a = 0; a < 3; ++a) normal[a] = a == axis ? side : 0;
     }
   return best < INFINITY;
-}
-
-// out = S w for a 3 x 3 S (row-major).
-void multiply3(const double S[9], const double w[3], double out[3]) {
-  for (int a = 0; a < 3; ++a) out[a] = S[3 * a] * w[0] + S[3 * a + 1] * w[1] + S[3 * a + 2] * w[2];
 }
 
 // 1 / (1/m + n . ((I^-1 (a x n)) x a)): the mass the impulse along n at arm a meets on one body.

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "simd_dispatch.h"
+#include "vec3.h"
 
 namespace quiver::rt {
 
@@ -22,14 +23,6 @@ struct Moments {
 
 // Levi-Civita symbol e_abc.
 double epsilon(int a, int b, int c) { return 0.5 * (a - b) * (b - c) * (c - a); }
-
-void rotate(const double R[9], const double v[3], double out[3]) {
-  for (int a = 0; a < 3; ++a) out[a] = R[3 * a] * v[0] + R[3 * a + 1] * v[1] + R[3 * a + 2] * v[2];
-}
-
-void rotateBack(const double R[9], const double v[3], double out[3]) {
-  for (int a = 0; a < 3; ++a) out[a] = R[a] * v[0] + R[3 + a] * v[1] + R[6 + a] * v[2];
-}
 
 // x = S^-1 b for a symmetric positive definite 3 x 3 S, by its adjugate.
 void solve3(const double S[9], const double b[3], double x[3]) {
@@ -56,10 +49,6 @@ void inverse3(const double S[9], double out[9]) {
     solve3(S, e, column);
     for (int a = 0; a < 3; ++a) out[3 * a + c] = column[a];
   }
-}
-
-void cross(const double a[3], const double b[3], double out[3]) {
-  out[0] = a[1] * b[2] - a[2] * b[1], out[1] = a[2] * b[0] - a[0] * b[2], out[2] = a[0] * b[1] - a[1] * b[0];
 }
 
 // x = A^-1 b for a general 3 x 3 A (row-major), by Cramer's rule; false where A is singular.
@@ -182,14 +171,14 @@ void RigidFrame::refresh(const qv_model& model, const double* q, const double* q
         if (a != b && a != c && b != c) internal[c] += epsilon(c, a, b) * dot(moments + (3 * a + b) * static_cast<size_t>(r), qdot, r);
   }
   double bodyL[3];
-  rotateBack(rotation, angularMomentum, bodyL);
+  multiplyTransposed3(rotation, angularMomentum, bodyL);
   for (int c = 0; c < 3; ++c) bodyL[c] -= internal[c];
   solve3(inertia, bodyL, bodyOmega);
 }
 
 double RigidFrame::spinRate(const qv_model& model) const {
   double bodyL[3], w[3], rest[3], I0[9];
-  rotateBack(rotation, angularMomentum, bodyL);
+  multiplyTransposed3(rotation, angularMomentum, bodyL);
   for (int c = 0; c < 3; ++c) bodyL[c] -= internal[c];
   solve3(inertia, bodyL, w);
   inertiaOf(Moments(model).S0, I0);
@@ -197,18 +186,18 @@ double RigidFrame::spinRate(const qv_model& model) const {
   return std::sqrt(std::fmax(dot(w, w, 3), dot(rest, rest, 3)));
 }
 
-void RigidFrame::worldOmega(double omega[3]) const { rotate(rotation, bodyOmega, omega); }
+void RigidFrame::worldOmega(double omega[3]) const { multiply3(rotation, bodyOmega, omega); }
 
 void RigidFrame::setWorldOmega(const double omega[3]) {
-  rotateBack(rotation, omega, bodyOmega);
+  multiplyTransposed3(rotation, omega, bodyOmega);
   double bodyL[3];
   for (int a = 0; a < 3; ++a) bodyL[a] = dot(inertia + 3 * a, bodyOmega, 3) + internal[a];
-  rotate(rotation, bodyL, angularMomentum);
+  multiply3(rotation, bodyL, angularMomentum);
   turnCredit = 0;
 }
 
 void RigidFrame::holdSpin() {
-  rotateBack(rotation, angularMomentum, heldMomentum);
+  multiplyTransposed3(rotation, angularMomentum, heldMomentum);
   for (int c = 0; c < 3; ++c) heldMomentum[c] -= internal[c];
   std::memcpy(heldAngularMomentum, angularMomentum, sizeof heldAngularMomentum);
 }
@@ -216,7 +205,7 @@ void RigidFrame::holdSpin() {
 double RigidFrame::turnExcess(const qv_model& model, const double* q, const double* qdot) {
   refresh(model, q, qdot);
   double next[3], w[3], v[3];
-  rotateBack(rotation, angularMomentum, next);
+  multiplyTransposed3(rotation, angularMomentum, next);
   for (int c = 0; c < 3; ++c) next[c] -= internal[c];
   solve3(inertia, next, w);
   solve3(inertia, heldMomentum, v);
@@ -302,7 +291,7 @@ void RigidFrame::move(double h) {
   const double dt = h / substeps;
   for (int sub = 0; sub < substeps; ++sub) {
     double P[3], end[3], m[3], w[3];
-    rotateBack(rotation, angularMomentum, P);
+    multiplyTransposed3(rotation, angularMomentum, P);
     std::memcpy(end, P, sizeof end);
     const auto midpoint = [&] {
       double b[3];
@@ -314,7 +303,7 @@ void RigidFrame::move(double h) {
     for (int it = 0; it < 6; ++it) {
       midpoint();
       double residual[3], c[3];
-      cross(m, w, c);
+      cross3(m, w, c);
       for (int a = 0; a < 3; ++a) residual[a] = P[a] + dt * c[a] - end[a];
       // d(m x w)/d end = ([m]x I^-1 - [w]x) / 2.
       double J[9];
@@ -333,7 +322,7 @@ void RigidFrame::move(double h) {
     }
     midpoint();
     double omega[3];
-    rotate(rotation, w, omega);
+    multiply3(rotation, w, omega);
     const double start[4] = {orientation[0], orientation[1], orientation[2], orientation[3]};
     turn(start, omega, dt);
   }
@@ -353,19 +342,19 @@ void RigidFrame::turn(const double from[4], const double omega[3], double t) {
 }
 
 void RigidFrame::toWorld(const double p[3], double out[3]) const {
-  rotate(rotation, p, out);
+  multiply3(rotation, p, out);
   for (int a = 0; a < 3; ++a) out[a] += position[a];
 }
 
-void RigidFrame::toBody(const double f[3], double out[3]) const { rotateBack(rotation, f, out); }
+void RigidFrame::toBody(const double f[3], double out[3]) const { multiplyTransposed3(rotation, f, out); }
 
-void RigidFrame::toWorldDirection(const double v[3], double out[3]) const { rotate(rotation, v, out); }
+void RigidFrame::toWorldDirection(const double v[3], double out[3]) const { multiply3(rotation, v, out); }
 
 void RigidFrame::inverseInertia(const double w[3], double out[3]) const {
   double body[3], x[3];
-  rotateBack(rotation, w, body);
+  multiplyTransposed3(rotation, w, body);
   solve3(inertia, body, x);
-  rotate(rotation, x, out);
+  multiply3(rotation, x, out);
 }
 
 void RigidFrame::inverseInertiaMatrix(double out[9]) const {

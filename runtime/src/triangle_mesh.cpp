@@ -7,20 +7,13 @@
 #include <new>
 
 #include "block_carver.h"
+#include "vec3.h"
 
 namespace quiver::rt {
 
 namespace {
 
 constexpr int kLeafSize = 4;
-
-double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-void cross3(const double a[3], const double b[3], double out[3]) {
-  out[0] = a[1] * b[2] - a[2] * b[1];
-  out[1] = a[2] * b[0] - a[0] * b[2];
-  out[2] = a[0] * b[1] - a[1] * b[0];
-}
 
 void normalise(double v[3]) {
   const double len = std::sqrt(dot3(v, v));
