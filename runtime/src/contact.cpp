@@ -117,13 +117,13 @@ bool boxFacingDistance(const double p[3], const double e[3], const double facing
   return best < INFINITY;
 }
 
-// 1 / (1/m + n . ((I^-1 (a x n)) x a)): the mass the impulse along n at arm a meets on one body.
-double inverseMass(const ContactBody& b, const double a[3], const double n[3]) {
-  double an[3], ian[3], back[3];
-  cross3(a, n, an);
-  multiply3(b.inverseInertia, an, ian);
-  cross3(ian, a, back);
-  return 1.0 / b.instance->model->info.total_mass + dot3(n, back);
+// The spin an impulse along d at arm a gives a body per unit, I^-1 (a x d), into `turn`; returns
+// 1/m + (a x d) . I^-1 (a x d), the inverse of the mass the impulse meets there.
+double turnPerImpulse(const ContactBody& b, const double a[3], const double d[3], double turn[3]) {
+  double ad[3];
+  cross3(a, d, ad);
+  multiply3(b.inverseInertia, ad, turn);
+  return b.inverseMass + dot3(ad, turn);
 }
 
 // The frame's velocity at a point with arm a, as the solve's impulses so far leave it.
@@ -133,16 +133,12 @@ void bodyPointVelocity(const ContactBody& b, const double a[3], double out[3]) {
   for (int k = 0; k < 3; ++k) out[k] = b.velocity[k] + wa[k];
 }
 
-void applyImpulse(ContactBody& b, const double a[3], const double J[3], double sign) {
-  double aj[3], dw[3];
-  cross3(a, J, aj);
-  for (int k = 0; k < 3; ++k) aj[k] *= sign;
-  multiply3(b.inverseInertia, aj, dw);
-  const double mass = b.instance->model->info.total_mass;
+// The impulse J = sum_k lambda_k d_k along the contact's directions (normal, tangents), times sign,
+// on a body's velocity and spin; `turns`: the turnPerImpulse() of each direction at its arm.
+void applyImpulse(ContactBody& b, const double turns[3][3], const double lambda[3], const double J[3], double sign) {
   for (int k = 0; k < 3; ++k) {
-    b.velocity[k] += sign * J[k] / mass;
-    b.angularMomentum[k] += aj[k];
-    b.spin[k] += dw[k];
+    b.velocity[k] += sign * b.inverseMass * J[k];
+    b.spin[k] += sign * (lambda[0] * turns[0][k] + lambda[1] * turns[1][k] + lambda[2] * turns[2][k]);
   }
 }
 
@@ -695,7 +691,7 @@ void takeMomenta(ContactBody* bodies, int count, const qv_collider* colliders, i
     ContactBody& b = bodies[i];
     const RigidFrame& f = b.instance->frame;
     std::memcpy(b.velocity, f.velocity, sizeof b.velocity);
-    std::memcpy(b.angularMomentum, f.angularMomentum, sizeof b.angularMomentum);
+    b.inverseMass = 1.0 / b.instance->model->info.total_mass;
     f.worldOmega(b.omega);
     std::memcpy(b.spin, b.omega, sizeof b.spin);
     f.inverseInertiaMatrix(b.inverseInertia);
@@ -852,16 +848,30 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     }
     for (int a = 0; a < 3; ++a) out[a] -= other[a];
   };
-  const auto effectiveMass = [&](const Contact& ct, const double n[3]) {
-    double inverse = inverseMass(bodies[ct.body], ct.arm, n) + (ct.other >= 0 ? inverseMass(bodies[ct.other], ct.otherArm, n) : 0.0);
-    if (ct.rows) inverse += modeGiving(*bodies[ct.body].instance, ct.rows, n);
-    if (ct.otherRows) inverse += modeGiving(*bodies[ct.other].instance, ct.otherRows, n);
-    return 1.0 / inverse;
+  // The mass an impulse along each of the contact's directions meets, and the spin it gives each
+  // side per unit (ContactTurns), formed once a solve.
+  const auto meetMasses = [&](Contact& ct, ContactTurns& turns) {
+    const double* directions[3] = {ct.normal, ct.tangent[0], ct.tangent[1]};
+    double inverse[3];
+    for (int k = 0; k < 3; ++k) {
+      const double* d = directions[k];
+      inverse[k] = turnPerImpulse(bodies[ct.body], ct.arm, d, turns.body[k]);
+      if (ct.other >= 0) inverse[k] += turnPerImpulse(bodies[ct.other], ct.otherArm, d, turns.other[k]);
+      if (ct.rows) inverse[k] += modeGiving(*bodies[ct.body].instance, ct.rows, d);
+      if (ct.otherRows) inverse[k] += modeGiving(*bodies[ct.other].instance, ct.otherRows, d);
+    }
+    ct.normalMass = 1.0 / inverse[0];
+    for (int t = 0; t < 2; ++t) ct.tangentMass[t] = 1.0 / inverse[1 + t];
   };
-  // An impulse on the frames and on the deformations where they give way.
-  const auto apply = [&](const Contact& ct, const double J[3]) {
-    applyImpulse(bodies[ct.body], ct.arm, J, 1);
-    if (ct.other >= 0) applyImpulse(bodies[ct.other], ct.otherArm, J, -1);
+  // The impulse sum_k lambda_k (normal, tangent 0, tangent 1)_k at contact j on the frames and on
+  // the deformations where they give way.
+  const auto apply = [&](int j, const double lambda[3]) {
+    const Contact& ct = list.contacts[j];
+    const ContactTurns& turns = list.turns[j];
+    double J[3];
+    for (int a = 0; a < 3; ++a) J[a] = lambda[0] * ct.normal[a] + lambda[1] * ct.tangent[0][a] + lambda[2] * ct.tangent[1][a];
+    applyImpulse(bodies[ct.body], turns.body, lambda, J, 1);
+    if (ct.other >= 0) applyImpulse(bodies[ct.other], turns.other, lambda, J, -1);
     if (ct.rows) pushModes(*bodies[ct.body].instance, ct.rows, J, 1);
     if (ct.otherRows) pushModes(*bodies[ct.other].instance, ct.otherRows, J, -1);
   };
@@ -896,8 +906,6 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     // Approach until the surfaces meet, no further; push out what penetrates beyond the slop.
     const double pushOut = 0.2 * (-ct.depth - slop) / h;
     ct.target = ct.depth > slop ? -ct.depth / h : deep(ct, s, h) ? std::fmin(pushOut, kMaxPushOut) : pushOut;
-    ct.normalMass = effectiveMass(ct, ct.normal);
-    ct.restingImpulse = 4 * ct.normalMass * (norm3(s.frame.gravity) * h + slop / h);
     // Tangents: the sliding direction first (any, when not sliding).
     double t0[3] = {vel[0] - vn * ct.normal[0], vel[1] - vn * ct.normal[1], vel[2] - vn * ct.normal[2]};
     double len = norm3(t0);
@@ -908,7 +916,8 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     }
     for (int a = 0; a < 3; ++a) ct.tangent[0][a] = t0[a] / len;
     cross3(ct.normal, ct.tangent[0], ct.tangent[1]);
-    for (int t = 0; t < 2; ++t) ct.tangentMass[t] = effectiveMass(ct, ct.tangent[t]);
+    meetMasses(ct, list.turns[j]);
+    ct.restingImpulse = 4 * ct.normalMass * (norm3(s.frame.gravity) * h + slop / h);
   }
   // Warm start: a contact held since the last step starts from the impulses it ended with (the
   // friction's turned into this step's tangents, within its disc), as if the last solve went on.
@@ -916,16 +925,15 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     Contact& ct = list.contacts[j];
     const Contact* last = std::lower_bound(list.previous, list.previous + list.previousCount, ct, keyBefore);
     if (last == list.previous + list.previousCount || keyBefore(ct, *last) || ct.bounce > 0) continue;
-    double friction[3], J[3];
+    double friction[3];
     for (int a = 0; a < 3; ++a)
       friction[a] = last->tangentImpulse[0] * last->tangent[0][a] + last->tangentImpulse[1] * last->tangent[1][a];
     ct.normalImpulse = last->normalImpulse;
     for (int t = 0; t < 2; ++t) ct.tangentImpulse[t] = dot3(friction, ct.tangent[t]);
     const double size = std::hypot(ct.tangentImpulse[0], ct.tangentImpulse[1]), limit = ct.friction * ct.normalImpulse;
     if (size > limit) ct.tangentImpulse[0] *= limit / size, ct.tangentImpulse[1] *= limit / size;
-    for (int a = 0; a < 3; ++a)
-      J[a] = ct.normalImpulse * ct.normal[a] + ct.tangentImpulse[0] * ct.tangent[0][a] + ct.tangentImpulse[1] * ct.tangent[1][a];
-    apply(ct, J);
+    const double lambda[3] = {ct.normalImpulse, ct.tangentImpulse[0], ct.tangentImpulse[1]};
+    apply(j, lambda);
   }
   // Islands: the bodies the contacts join, each swept until its impulses settle (kConverged), an
   // island with a bounce at least until the bounce's sweeps (after kSweeps / 2). Islands share no
@@ -968,9 +976,8 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
       const double stiff = ct.normalImpulse > ct.restingImpulse ? 1.0 : 1 + kSoftness;
       ct.normalImpulse = std::fmax(0.0, before + (ct.target - dot3(vel, ct.normal) - kSoftness * soft / ct.normalMass) /
                                                  (stiff / ct.normalMass));
-      double J[3];
-      for (int a = 0; a < 3; ++a) J[a] = (ct.normalImpulse - before) * ct.normal[a];
-      apply(ct, J);
+      const double push[3] = {ct.normalImpulse - before, 0, 0};
+      apply(j, push);
       // Friction: the accumulated tangent impulse within the disc of radius mu * normal impulse.
       relativeVelocity(ct, vel);
       const double limit = ct.friction * ct.normalImpulse;
@@ -979,9 +986,9 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
       for (int t = 0; t < 2; ++t) next[t] = old[t] - ct.tangentMass[t] * dot3(vel, ct.tangent[t]);
       const double size = std::sqrt(next[0] * next[0] + next[1] * next[1]);
       if (size > limit) next[0] *= limit / size, next[1] *= limit / size;
-      for (int a = 0; a < 3; ++a) J[a] = (next[0] - old[0]) * ct.tangent[0][a] + (next[1] - old[1]) * ct.tangent[1][a];
+      const double rub[3] = {0, next[0] - old[0], next[1] - old[1]};
       ct.tangentImpulse[0] = next[0], ct.tangentImpulse[1] = next[1];
-      apply(ct, J);
+      apply(j, rub);
       const double change = std::fabs(ct.normalImpulse - startNormal) + std::fabs(next[0] - startTangent[0]) +
                             std::fabs(next[1] - startTangent[1]);
       island.islandMoved |= change > kConverged * ct.restingImpulse;
@@ -995,10 +1002,23 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     }
   }
   for (int i = 0; i < bodyCount; ++i) {
-    RigidFrame& f = bodies[i].instance->frame;
-    std::memcpy(f.velocity, bodies[i].velocity, sizeof f.velocity);
-    std::memcpy(f.angularMomentum, bodies[i].angularMomentum, sizeof f.angularMomentum);
+    std::memcpy(bodies[i].instance->frame.velocity, bodies[i].velocity, sizeof bodies[i].velocity);
     if (bodies[i].modesPredicted) bodies[i].instance->softContact = true;
+  }
+  // The angular momenta the impulses add, a x J for each contact's whole impulse (the solve steps
+  // the spin alone).
+  for (int j = 0; j < list.count; ++j) {
+    const Contact& ct = list.contacts[j];
+    double J[3], turn[3];
+    for (int a = 0; a < 3; ++a)
+      J[a] = ct.normalImpulse * ct.normal[a] + ct.tangentImpulse[0] * ct.tangent[0][a] + ct.tangentImpulse[1] * ct.tangent[1][a];
+    cross3(ct.arm, J, turn);
+    double* L = bodies[ct.body].instance->frame.angularMomentum;
+    for (int a = 0; a < 3; ++a) L[a] += turn[a];
+    if (ct.other < 0) continue;
+    cross3(ct.otherArm, J, turn);
+    L = bodies[ct.other].instance->frame.angularMomentum;
+    for (int a = 0; a < 3; ++a) L[a] -= turn[a];
   }
   // The same impulses over the step load the deformations where they act, less the bounce: the
   // restitution already returns that energy to the frames, and loading q with it too would make energy.

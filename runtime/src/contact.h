@@ -40,14 +40,16 @@
 
 namespace quiver::rt {
 
-// A flying instance in a contact solve: its frame's momenta as the impulses change them.
+// A flying instance in a contact solve: its frame's velocity and spin as the impulses change them
+// (the angular momenta they add go to the frame once the solve ends).
 struct ContactBody {
   qv_instance* instance = nullptr;
-  double velocity[3] = {}, angularMomentum[3] = {};
+  double velocity[3] = {}, inverseMass = 0;
   double omega[3] = {};  // the world angular velocity before the solve
   // In the solve: the world angular velocity its impulses so far give (omega + I^-1 of the angular
   // momentum they added), and the world inverse inertia they act through (RigidFrame's, held while
-  // the frame does not move), so that each impulse costs a product rather than a 3 x 3 solve.
+  // the frame does not move), which each contact's directions are turned through once a solve
+  // (ContactTurns).
   double spin[3] = {};
   double inverseInertia[9] = {};
   // In the solve: the island it is in (the lowest index of the bodies its contacts join), and at an

@@ -37,6 +37,13 @@ struct Contact {
   const double* otherRows = nullptr;
 };
 
+// A contact's directions (normal, tangent 0, tangent 1) in the solve: the spin a unit impulse along
+// each gives its body, I^-1 (arm x d), and the other body (at its own arm), so that each impulse
+// costs the solve a few multiply-adds. Formed once a solve; not kept from step to step.
+struct ContactTurns {
+  double body[3][3] = {}, other[3][3] = {};
+};
+
 // Contacts by who touches what where: the warm start finds last step's by it, and the solve runs
 // in its order whichever contacts the capacity kept.
 inline bool keyBefore(const Contact& x, const Contact& y) {
@@ -57,10 +64,11 @@ struct ContactPair {
 };
 
 // Where a solve puts its contacts: `contacts` this step's, `previous` the last step's (sorted by
-// key); two arrays of `capacity` that trade places each step; `pairs`, `capacity` more.
+// key); two arrays of `capacity` that trade places each step; `turns` and `pairs`, `capacity` more.
 struct ContactList {
   Contact* contacts = nullptr;
   Contact* previous = nullptr;
+  ContactTurns* turns = nullptr;  // contacts' (the solve's)
   ContactPair* pairs = nullptr;
   int count = 0, previousCount = 0, capacity = 0;
   int pairCount = 0;

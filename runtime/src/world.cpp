@@ -51,6 +51,7 @@ size_t layOut(const qv_world_config& config, char* block, qv_world** world) {
   broad.carve(c, config.max_instances);
   Contact* contacts = c.take<Contact>(static_cast<size_t>(config.max_contacts));
   Contact* previous = c.take<Contact>(static_cast<size_t>(config.max_contacts));
+  ContactTurns* turns = c.take<ContactTurns>(static_cast<size_t>(config.max_contacts));
   ContactPair* pairs = c.take<ContactPair>(static_cast<size_t>(config.max_contacts));
   if (block) {
     w = new (w) qv_world{};
@@ -61,6 +62,7 @@ size_t layOut(const qv_world_config& config, char* block, qv_world** world) {
     w->broad = broad;
     w->contacts.contacts = contacts;
     w->contacts.previous = previous;
+    w->contacts.turns = turns;
     w->contacts.pairs = pairs;
     w->contacts.capacity = config.max_contacts;
     *world = w;

@@ -140,6 +140,7 @@ TEST(BroadPhase, AContactSolveFindsWhatTestingEveryPairFinds) {
       std::vector<std::unique_ptr<test::Instance>> instances[2];
       std::vector<ContactBody> bodies[2];
       std::vector<Contact> contacts[2], previous[2];
+      std::vector<ContactTurns> turns[2];
       std::vector<ContactPair> pairs[2];
       ContactList lists[2];
       for (int set = 0; set < 2; ++set) {
@@ -154,7 +155,9 @@ TEST(BroadPhase, AContactSolveFindsWhatTestingEveryPairFinds) {
           bodies[set][i].instance = s;
         }
         contacts[set].resize(capacity), previous[set].resize(capacity), pairs[set].resize(capacity);
+        turns[set].resize(capacity);
         lists[set].contacts = contacts[set].data(), lists[set].previous = previous[set].data();
+        lists[set].turns = turns[set].data();
         lists[set].pairs = pairs[set].data(), lists[set].capacity = capacity;
       }
       Scene broad(n);
