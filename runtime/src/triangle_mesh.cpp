@@ -270,15 +270,23 @@ void destroyTriangleMesh(qv_triangle_mesh* mesh) {
 bool qv_triangle_mesh::distance(const double p[3], double reach, double& signedDistance, double normal[3], int* triangle,
                                 const double* facing) const {
   using namespace quiver::rt;
-  if (boxDistance2(nodes[0], p) > reach * reach) return false;
-  // Nearest first: the nearer child is searched first, and a box farther than the best so far is skipped.
-  int stack[64], depth = 0;
-  stack[depth++] = 0;
+  const double rootDistance2 = boxDistance2(nodes[0], p);
+  if (rootDistance2 > reach * reach) return false;
+  // Nearest first: the nearer child is searched first, and a box farther than the best so far is
+  // skipped. Each box's distance is kept with it on the stack, worked out once.
+  struct Pending {
+    int node;
+    double distance2;
+  };
+  Pending stack[64];
+  int depth = 0;
+  stack[depth++] = {0, rootDistance2};
   double best = INFINITY, closest[3] = {};
   int bestTriangle = 0, bestFeature = 6;
   while (depth) {
-    const BvhNode& node = nodes[stack[--depth]];
-    if (boxDistance2(node, p) >= best) continue;
+    const Pending pending = stack[--depth];
+    if (pending.distance2 >= best) continue;
+    const BvhNode& node = nodes[pending.node];
     if (node.count) {
       for (int i = node.first; i < node.first + node.count; ++i) {
         const int t = order[i];
@@ -292,9 +300,11 @@ bool qv_triangle_mesh::distance(const double p[3], double reach, double& signedD
       }
       continue;
     }
-    const int near = boxDistance2(nodes[node.first], p) <= boxDistance2(nodes[node.first + 1], p) ? node.first : node.first + 1;
-    stack[depth++] = near == node.first ? node.first + 1 : node.first;
-    stack[depth++] = near;
+    const Pending first = {node.first, boxDistance2(nodes[node.first], p)};
+    const Pending second = {node.first + 1, boxDistance2(nodes[node.first + 1], p)};
+    const bool firstNearer = first.distance2 <= second.distance2;
+    stack[depth++] = firstNearer ? second : first;
+    stack[depth++] = firstNearer ? first : second;
   }
   if (triangle) *triangle = bestTriangle;
   if (facing) {
