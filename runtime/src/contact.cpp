@@ -552,6 +552,8 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
   // A side with soft contacts is its deformed surface: a's vertex where its deformation moved it, b's
   // surface moved where its nearest vertex moved along the normal.
   const bool softA = a.modeCompliance != nullptr, softB = b.modeCompliance != nullptr;
+  // Each of a's vertices is a query below, which finds nothing farther than the margin (keptReach()).
+  if (!softA && boxesApart(a, b, margin)) return;
   // Where either turns fast, the straight paths the margin covers overshoot (kStraightTurn): a's
   // vertex stays within its arm of a's centre, b's rest surface within its radius of b's. Rigid
   // contacts only (a soft side's deformation moves its surface besides).
@@ -622,6 +624,37 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
 }
 
 } // namespace
+
+bool boxesApart(const qv_instance& a, const qv_instance& b, double margin) {
+  const BvhNode& root = b.model->surfaceMesh->nodes[0];
+  double centreA[3], centreB[3], extentA[3], extentB[3], worldA[3], worldB[3], t[3], C[9];
+  for (int k = 0; k < 3; ++k) {
+    centreA[k] = 0.5 * (a.surfaceLow[k] + a.surfaceHigh[k]), extentA[k] = 0.5 * (a.surfaceHigh[k] - a.surfaceLow[k]);
+    centreB[k] = 0.5 * (root.lo[k] + root.hi[k]) - b.model->rigidBody[k], extentB[k] = 0.5 * (root.hi[k] - root.lo[k]);
+  }
+  a.frame.toWorld(centreA, worldA);
+  b.frame.toWorld(centreB, worldB);
+  for (int k = 0; k < 3; ++k) worldB[k] -= worldA[k];
+  a.frame.toBody(worldB, t);  // b's centre from a's, in a's axes
+  const double *Ra = a.frame.rotation, *Rb = b.frame.rotation;
+  for (int i = 0; i < 3; ++i)  // C_ij = a's axis i . b's axis j
+    for (int j = 0; j < 3; ++j) C[3 * i + j] = std::fabs(Ra[i] * Rb[j] + Ra[3 + i] * Rb[3 + j] + Ra[6 + i] * Rb[6 + j]) + 1e-9;
+  const auto apart = [&](double distance, double reachA, double reachB) {
+    return distance - reachA - reachB > margin + 1e-9 * (distance + reachA + reachB + margin) + 1e-12;
+  };
+  for (int i = 0; i < 3; ++i)
+    if (apart(std::fabs(t[i]), extentA[i], extentB[0] * C[3 * i] + extentB[1] * C[3 * i + 1] + extentB[2] * C[3 * i + 2]))
+      return true;
+  for (int j = 0; j < 3; ++j) {
+    double along = 0, reachA = 0;
+    for (int i = 0; i < 3; ++i) {
+      along += t[i] * (Ra[i] * Rb[j] + Ra[3 + i] * Rb[3 + j] + Ra[6 + i] * Rb[6 + j]);
+      reachA += extentA[i] * C[3 * i + j];
+    }
+    if (apart(std::fabs(along), reachA, extentB[j])) return true;
+  }
+  return false;
+}
 
 bool validCollider(const qv_collider& c) {
   if (!finiteAll(c.data, 8) || !finiteAll(c.rotation, 3) || !finiteAll(c.velocity, 3) ||

@@ -82,6 +82,13 @@ bool colliderDistance(const qv_collider& collider, const double p[3], double rea
                       const double* facing = nullptr);
 bool validCollider(const qv_collider& collider);
 
+// Whether a's rest surface vertices, carried by its frame, all lie farther than `margin` from b's
+// rest surface: the boxes around them in their bodies' axes are farther apart than that along one
+// of the six face normals (the separating axes of two boxes that need no cross product), by more
+// than rounding. In a pile most bars near enough for their spheres are apart so, and each of a's
+// vertices would be a closest-point query that finds nothing.
+bool boxesApart(const qv_instance& a, const qv_instance& b, double margin);
+
 // The solve starts from the frames' momenta as their velocity updates left them: takes them into
 // `bodies`, and groups the bodies and spreads their speeds (contact.cpp, spreadSpeeds()). Call
 // after the frames' velocity updates, before wakeSleepers() and solveContacts(), and again after

@@ -93,7 +93,12 @@ qv_instance* constructInstance(const qv_model& model, const qv_instance_config& 
     s->surfaceCount = model.contactCount;
     for (int k = 0; k < s->surfaceCount; ++k) {
       double r2 = 0;
-      for (int a = 0; a < 3; ++a) r2 += std::pow(model.rest[3 * s->surfaceVertices[k] + a] - model.rigidBody[a], 2);
+      for (int a = 0; a < 3; ++a) {
+        const double x = model.rest[3 * s->surfaceVertices[k] + a] - model.rigidBody[a];
+        r2 += x * x;
+        s->surfaceLow[a] = k ? std::fmin(s->surfaceLow[a], x) : x;
+        s->surfaceHigh[a] = k ? std::fmax(s->surfaceHigh[a], x) : x;
+      }
       s->surfaceRadius = std::fmax(s->surfaceRadius, std::sqrt(r2));
     }
     double d2 = 0;
