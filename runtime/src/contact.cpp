@@ -185,6 +185,17 @@ void worldVertex(const qv_instance& s, int v, bool deformed, double out[3]) {
   s.frame.toWorld(body, out);
 }
 
+// Contact point n of a body (its surface vertex), carried by its frame: of its rest shape, or
+// deformed by q where `deformed` (a soft body's as its last deformSurface() placed them).
+void surfacePoint(const qv_instance& s, int n, bool deformed, double out[3]) {
+  if (deformed && s.deformedSurface) {
+    s.frame.toWorld(s.deformedSurface + 3 * n, out);
+  } else {
+    worldVertex(s, s.surfaceVertices[n], deformed, out);
+  }
+}
+
+
 // Signed distance of world point p to a body's rest surface carried by its frame; the surface
 // vertex nearest the closest point through `vertex`. False when beyond `reach`. With `facing` (a
 // world direction), to the surface facing against it only (qv_triangle_mesh::distance).
@@ -495,7 +506,7 @@ void findColliderContacts(ContactBody* bodies, int i, const qv_collider* collide
   for (int n = 0; n < s.surfaceCount && count; ++n) {
     const int v = s.surfaceVertices[n];
     double p[3];
-    worldVertex(s, v, deforms, p);
+    surfacePoint(s, n, deforms, p);
     // A deformed vertex also moves with the deformation, which can outrun the frame many times (a
     // bar's ends flung at the ground while it lies still).
     double flex = 0;
@@ -553,7 +564,7 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
   // surface moved where its nearest vertex moved along the normal.
   const bool softA = a.modeCompliance != nullptr, softB = b.modeCompliance != nullptr;
   // Each of a's vertices is a query below, which finds nothing farther than the margin (keptReach()).
-  if (!softA && boxesApart(a, b, margin)) return;
+  if (boxesApart(a, b, margin)) return;
   // Where either turns fast, the straight paths the margin covers overshoot (kStraightTurn): a's
   // vertex stays within its arm of a's centre, b's rest surface within its radius of b's. Rigid
   // contacts only (a soft side's deformation moves its surface besides).
@@ -577,7 +588,7 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
     const int v = a.surfaceVertices[n];
     double p[3], depth, normal[3];
     int otherVertex = 0;
-    worldVertex(a, v, softA, p);
+    surfacePoint(a, n, softA, p);
     const double reach = keptReach(list, margin, a.contactSlop);
     if (!bodyDistance(b, p, reach, depth, normal, &otherVertex) || depth > reach) continue;
     const double arm = distance3(p, a.frame.position);
@@ -624,6 +635,21 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
 }
 
 } // namespace
+
+void deformSurface(qv_instance& s) {
+  const qv_model& m = *s.model;
+  for (int n = 0; n < s.surfaceCount; ++n) {
+    const int v = s.surfaceVertices[n];
+    double u[3];
+    m.vertexLinear(v, s.q, u, nullptr);
+    double* x = s.deformedSurface + 3 * n;
+    for (int a = 0; a < 3; ++a) {
+      x[a] = m.rest[3 * v + a] - m.rigidBody[a] + u[a];  // as worldVertex() forms it
+      s.surfaceLow[a] = n ? std::fmin(s.surfaceLow[a], x[a]) : x[a];
+      s.surfaceHigh[a] = n ? std::fmax(s.surfaceHigh[a], x[a]) : x[a];
+    }
+  }
+}
 
 bool boxesApart(const qv_instance& a, const qv_instance& b, double margin) {
   const BvhNode& root = b.model->surfaceMesh->nodes[0];
@@ -844,6 +870,10 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
       }
     }
   };
+  for (int i = 0; i < bodyCount; ++i) {
+    qv_instance& s = *bodies[i].instance;
+    if (!s.asleep && s.deformedSurface) deformSurface(s);
+  }
   list.pairCount = list.touching = 0;
   find();
   if (list.touching > list.capacity) {  // again, keeping a spread subset of each pair's

@@ -154,6 +154,7 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
     if (config.soft_contacts && model->contactModes.stiffness) {
       modeCompliance = c.take<double>(r);
       modeVelocity = c.take<double>(r);
+      deformedSurface = c.take<double>(3 * static_cast<size_t>(model->contactCount));
     }
     contacts.contacts = c.take<quiver::rt::Contact>(static_cast<size_t>(config.max_contacts));
     contacts.previous = c.take<quiver::rt::Contact>(static_cast<size_t>(config.max_contacts));

@@ -114,7 +114,10 @@ struct qv_instance {
   const unsigned char* surfaceLevels = nullptr;
   int surfaceCount = 0;
   double surfaceRadius = 0;        // m: the farthest surface vertex from the centre of mass, at rest
-  double surfaceLow[3] = {}, surfaceHigh[3] = {};  // m: the box of the surface vertices at rest, body axes
+  // m: the box of the contact points in body axes, from the centre of mass: at rest, or with soft
+  // contacts as deformed at the last contact search (deformedSurface, 3 doubles each point, then).
+  double surfaceLow[3] = {}, surfaceHigh[3] = {};
+  double* deformedSurface = nullptr;
   double contactSlop = 0;          // m: penetration left alone
   // In a world (world.h): asleep, not stepped until woken; still for stillTime s (slower than its
   // sleep speed); sleepGroup: the group it fell asleep with (-1: none), which it wakes with.

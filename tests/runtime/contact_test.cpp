@@ -271,50 +271,76 @@ TEST(Contact, TheSolvesInverseInertiaInvertsTheWorldInertia) {
   EXPECT_GT((I - I.trace() / 3 * Eigen::Matrix3d::Identity()).norm(), 0.1 * I.norm());  // not round: R matters
 }
 
-// A pair of bodies whose surface boxes are apart (rt::boxesApart) is skipped by the narrow phase:
-// none of the first's surface vertices may lie within the margin of the second's surface, which
-// the second's own closest-point query measures here, for 20000 pairs of bars turned every way
-// and placed within their spheres' reach. And the skip is not idle: it takes many such pairs.
-TEST(Contact, BodiesWhoseBoxesAreApartHaveNoVertexWithinTheMargin) {
+// A pair of bodies whose contact points' boxes are apart (rt::boxesApart) is skipped by the narrow
+// phase: none of the first's contact points may lie within the margin of the second's surface,
+// which the second's own closest-point query measures here, for 20000 pairs of bars turned every
+// way and placed within their spheres' reach: rigid, and with soft contacts, bent and twisted so
+// that their deformed points (qv_instance_positions) leave the rest shape's box. And the skip is
+// not idle: it takes many such pairs.
+TEST(Contact, BodiesWhoseBoxesAreApartHaveNoContactPointWithinTheMargin) {
   FreeBar bar(10, {6, 1, 1});
-  const qv_instance_config config = bar.config(1.0 / 60);
-  test::Instance a(bar.model, config), b(bar.model, config);
-  const qv_model& m = *a.s->model;
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> unit(-1, 1), margins(0, 0.05);
-  const auto turned = [&](const Eigen::Vector3d& position) {
-    Eigen::Vector4d q(unit(rng), unit(rng), unit(rng), unit(rng));
-    q.normalize();
-    return qv_rigid_state{{position.x(), position.y(), position.z()}, {q[0], q[1], q[2], q[3]}, {0, 0, 0}, {0, 0, 0}};
-  };
-  int near = 0, skipped = 0;
-  for (int trial = 0; trial < 20000; ++trial) {
-    const double margin = margins(rng);
-    const Eigen::Vector3d where = Eigen::Vector3d(unit(rng), unit(rng), unit(rng)) * 0.7;
-    qv_rigid_state sa = turned(Eigen::Vector3d::Zero()), sb = turned(where);
-    ASSERT_EQ(qv_instance_set_rigid_state(a.s, &sa), QV_OK);
-    ASSERT_EQ(qv_instance_set_rigid_state(b.s, &sb), QV_OK);
-    if (where.norm() > a.s->surfaceRadius + b.s->surfaceRadius + margin) continue;
-    ++near;
-    double closest = INFINITY;  // of a's surface vertices to b's surface, signed
-    for (int k = 0; k < a.s->surfaceCount; ++k) {
-      const int v = a.s->surfaceVertices[k];
-      double body[3], world[3], rel[3], local[3], distance, normal[3];
-      for (int c = 0; c < 3; ++c) body[c] = m.rest[3 * v + c] - m.rigidBody[c];
-      a.s->frame.toWorld(body, world);
-      for (int c = 0; c < 3; ++c) rel[c] = world[c] - b.s->frame.position[c];
-      b.s->frame.toBody(rel, local);
-      for (int c = 0; c < 3; ++c) local[c] += m.rigidBody[c];
-      ASSERT_TRUE(m.surfaceMesh->distance(local, INFINITY, distance, normal));
-      closest = std::min(closest, distance);
+  for (const bool soft : {false, true}) {
+    qv_instance_config config = bar.config(1.0 / 60);
+    config.soft_contacts = soft;
+    test::Instance a(bar.model, config), b(bar.model, config);
+    ASSERT_EQ(a.s->deformedSurface != nullptr, soft);
+    const qv_model& m = *a.s->model;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> unit(-1, 1), margins(0, 0.05);
+    const auto turned = [&](const Eigen::Vector3d& position) {
+      Eigen::Vector4d q(unit(rng), unit(rng), unit(rng), unit(rng));
+      q.normalize();
+      return qv_rigid_state{{position.x(), position.y(), position.z()}, {q[0], q[1], q[2], q[3]}, {0, 0, 0}, {0, 0, 0}};
+    };
+    std::vector<double> q(bar.info.r, 0.0);
+    int near = 0, skipped = 0;
+    double outside = 0;  // the farthest a deformed point left the rest box
+    for (int trial = 0; trial < 20000; ++trial) {
+      const double margin = margins(rng);
+      const Eigen::Vector3d where = Eigen::Vector3d(unit(rng), unit(rng), unit(rng)) * 0.7;
+      qv_rigid_state sa = turned(Eigen::Vector3d::Zero()), sb = turned(where);
+      if (soft) {
+        for (double& x : q) x = 0.05 * unit(rng);
+      }
+      qv_instance_set_state(a.s, q.data(), nullptr, nullptr);
+      ASSERT_EQ(qv_instance_set_rigid_state(a.s, &sa), QV_OK);
+      ASSERT_EQ(qv_instance_set_rigid_state(b.s, &sb), QV_OK);
+      if (where.norm() > a.s->surfaceRadius + b.s->surfaceRadius + margin) continue;
+      ++near;
+      if (soft) rt::deformSurface(*a.s);
+      const Eigen::MatrixXd x = bar.positions(a.s);  // world, deformed
+      double closest = INFINITY;  // of a's contact points to b's surface, signed
+      for (int k = 0; k < a.s->surfaceCount; ++k) {
+        const int v = a.s->surfaceVertices[k];
+        double world[3], rel[3], local[3], body[3], distance, normal[3];
+        for (int c = 0; c < 3; ++c) body[c] = m.rest[3 * v + c] - m.rigidBody[c];
+        a.s->frame.toWorld(body, world);  // rigid: the rest shape carried by the frame
+        for (int c = 0; c < 3; ++c) rel[c] = (soft ? x(v, c) : world[c]) - b.s->frame.position[c];
+        b.s->frame.toBody(rel, local);
+        for (int c = 0; c < 3; ++c) local[c] += m.rigidBody[c];
+        ASSERT_TRUE(m.surfaceMesh->distance(local, INFINITY, distance, normal));
+        closest = std::min(closest, distance);
+        if (soft) {
+          for (int c = 0; c < 3; ++c) rel[c] = x(v, c) - a.s->frame.position[c];
+          a.s->frame.toBody(rel, body);
+          for (int c = 0; c < 3; ++c)
+            outside = std::max({outside, body[c] - (m.info.bbox_max[c] - m.rigidBody[c]), (m.info.bbox_min[c] - m.rigidBody[c]) - body[c]});
+        }
+      }
+      if (!rt::boxesApart(*a.s, *b.s, margin)) continue;
+      ++skipped;
+      // (qv_instance_positions gives floats: a micron covers their rounding)
+      ASSERT_GT(closest, margin - (soft ? 1e-6 : 0)) << (soft ? "soft" : "rigid") << " trial " << trial << ": skipped with a point " << closest
+                                 << " m from the other's surface";
     }
-    if (!rt::boxesApart(*a.s, *b.s, margin)) continue;
-    ++skipped;
-    ASSERT_GT(closest, margin) << "trial " << trial << ": skipped with a vertex " << closest << " m from the other's surface";
+    std::printf("%s: %d pairs within their spheres' reach, %d skipped; deformed points up to %.3f m outside the rest box\n",
+                soft ? "soft" : "rigid", near, skipped, outside);
+    EXPECT_GT(near, 5000);
+    EXPECT_GT(skipped, near / 4);
+    if (soft) {
+      EXPECT_GT(outside, 0.02);
+    }
   }
-  std::printf("%d pairs within their spheres' reach, %d skipped\n", near, skipped);
-  EXPECT_GT(near, 5000);
-  EXPECT_GT(skipped, near / 4);
 }
 
 TEST(Contact, BadCollidersAndGroundedInstancesAreRefused) {
