@@ -489,8 +489,8 @@ StepStatus. Instances in a World are refused: the world steps them.)");
 World(*, max_instances=64, max_contacts=4096, friction=0.5, restitution=0.0, sleep_speed=0.02, sleep_time=0.5):
 friction and restitution between instances; a group of instances that could touch, all slower than sleep_speed
 (m/s; 0: never) for sleep_time (s), falls asleep until something wakes it (Instance.asleep, Instance.wake()).
-add(instance) puts a flying instance in (all with the same time step); step() steps every awake instance once
-and returns how many reset. The world keeps its instances alive.)")
+add(instance) puts a flying instance in (all with the same time step), remove(instance) takes it out; step()
+steps every awake instance once and returns how many reset. The world keeps its instances alive.)")
       .def(py::init([](std::optional<int> maxInstances, std::optional<int> maxContacts, std::optional<double> friction,
                        std::optional<double> restitution, std::optional<double> sleepSpeed, std::optional<double> sleepTime) {
              qv_world_config c;
@@ -527,6 +527,20 @@ and returns how many reset. The world keeps its instances alive.)")
         self.instances.push_back(std::move(instance));
         return index;
       }, py::arg("instance"), "Adds a flying instance; returns its index (as contacts name it).")
+      .def("remove", [](World& self, py::object instance) {
+        if (!py::isinstance<Instance>(instance)) throw py::type_error("World.remove takes a quiver.Instance");
+        Instance& s = instance.cast<Instance&>();
+        if (s.world != &self) throw py::value_error("the instance is not in this World");
+        if (qv_world_remove(self.use(), s.use()) != QV_OK) throw py::value_error("qv_world_remove refused the instance");
+        s.world = nullptr;
+        for (auto it = self.instances.begin(); it != self.instances.end(); ++it)
+          if (it->is(instance)) {
+            self.instances.erase(it);
+            break;
+          }
+      }, py::arg("instance"),
+           "Takes an instance out (a despawned object): the later ones move down an index, the others' contacts carry "
+           "on, and what slept with it wakes. It keeps its state, awake, and can be stepped alone or added again.")
       .def_property_readonly("instances", [](const World& self) {
         py::list out;
         for (const py::object& s : self.instances) out.append(s);

@@ -519,6 +519,16 @@ qv_result qv_world_add(qv_world* world, qv_instance* instance, int* index) {
   return QV_OK;
 }
 
+qv_result qv_world_remove(qv_world* world, qv_instance* instance) {
+  if (!world || !instance) return QV_ERROR_INVALID_ARGUMENT;
+  for (int i = 0; i < world->count; ++i)
+    if (world->instances[i] == instance) {
+      world->remove(i);
+      return QV_OK;
+    }
+  return QV_ERROR_INVALID_ARGUMENT;
+}
+
 qv_result qv_world_set_colliders(qv_world* world, const qv_collider* colliders, int count) {
   if (!world || !validColliders(colliders, count)) return QV_ERROR_INVALID_ARGUMENT;
   world->colliders = count ? colliders : nullptr;

@@ -180,6 +180,35 @@ bool qv_world::restoreSnapshot(const double* in, size_t bytes) {
   return true;
 }
 
+void qv_world::remove(int i) {
+  qv_instance& gone = *instances[i];
+  // What slept with it wakes (a stack whose lowest is taken away must fall); an awake instance has
+  // no sleeper's group id (wakeSleptWith()), so the ids above its index stay distinct one lower.
+  for (int j = 0; j < count; ++j) {
+    qv_instance& s = *instances[j];
+    if (j == i || s.sleepGroup < 0) continue;
+    if (gone.asleep && s.sleepGroup == gone.sleepGroup) {
+      s.wake(), s.sleepGroup = -1;
+    } else if (s.sleepGroup > i) {
+      --s.sleepGroup;
+    }
+  }
+  gone.wake(), gone.sleepGroup = -1;
+  gone.contacts.clear();  // stepped alone from here, from no contacts
+  for (int j = i + 1; j < count; ++j) instances[j - 1] = instances[j];
+  --count;
+  // The last step's contacts keep their order (by body, then other) with the indices above i one lower.
+  int kept = 0;
+  for (int k = 0; k < contacts.count; ++k) {
+    quiver::rt::Contact ct = contacts.contacts[k];
+    if (ct.body == i || ct.other == i) continue;
+    if (ct.body > i) --ct.body;
+    if (ct.other > i) --ct.other;
+    contacts.contacts[kept++] = ct;
+  }
+  contacts.count = kept;
+}
+
 void qv_world::wakeSleptWith() {
   // The caller woke these (and may have moved them away from the rest of their group): the
   // bodies they fell asleep with wake too (a stack whose lowest is taken away must fall). A

@@ -35,6 +35,9 @@ struct qv_world {
   size_t snapshotSize() const;
   size_t saveSnapshot(double* out) const;
   bool restoreSnapshot(const double* in, size_t bytes);
+  // Takes instance i out (qv_world_remove): the later ones move down an index, and the last
+  // step's contacts and sleep groups with them.
+  void remove(int i);
   void wakeSleptWith();
   void begin(int i);
   void settle(double h);

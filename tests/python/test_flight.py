@@ -155,6 +155,22 @@ def test_a_world_stacks_one_beam_on_another(free_model):
     assert world.instances == [low, high]
     with pytest.raises(ValueError, match="already in a World"):
         world.add(low)
+    # Despawning the lower: the upper, asleep on it, wakes and falls to the ground, named 0 now.
+    for _ in range(600):
+        world.step()
+        if low.asleep and high.asleep:
+            break
+    assert low.asleep and high.asleep
+    world.remove(low)
+    assert world.instances == [high] and not low.asleep and not high.asleep
+    for _ in range(60):
+        assert world.step() == 0
+    assert high.rigid_state.position[2] == pytest.approx(0.05, abs=0.01)
+    assert set(world.contacts()["instance"]) == {0}
+    low.step()  # alone now
+    with pytest.raises(ValueError, match="not in this World"):
+        world.remove(low)
+    assert world.add(low) == 1
     with pytest.raises(ValueError, match="is in a World"):
         quiver.step_many([low])
     with pytest.raises(ValueError, match="is in a World"):

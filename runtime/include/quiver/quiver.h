@@ -16,7 +16,7 @@ extern "C" {
 #endif
 
 #define QV_VERSION_MAJOR 0
-#define QV_VERSION_MINOR 15
+#define QV_VERSION_MINOR 16
 #define QV_VERSION_PATCH 0
 #define QV_VERSION_NUMBER (QV_VERSION_MAJOR * 10000 + QV_VERSION_MINOR * 100 + QV_VERSION_PATCH)
 
@@ -471,6 +471,11 @@ QV_API void qv_world_destroy(qv_world* world);
 /* Adds a flying instance (QV_ERROR_INVALID_ARGUMENT: not flying, already in, its time step differs from the
    others', or the world is full); returns its index through `index` when not NULL. */
 QV_API qv_result qv_world_add(qv_world* world, qv_instance* instance, int* index);
+/* Takes an instance out (QV_ERROR_INVALID_ARGUMENT: not in it), as a game despawns an object; remove an
+   instance before destroying it. The instances after it move down an index (as the last step's contacts
+   name them); the others' contacts carry on; the instances it fell asleep with wake (what rested on it
+   falls). It keeps its state and pose, awake, and may be stepped alone or added again. */
+QV_API qv_result qv_world_remove(qv_world* world, qv_instance* instance);
 /* The world's colliders, kept by pointer as qv_instance_set_colliders keeps them; wakes every instance. */
 QV_API qv_result qv_world_set_colliders(qv_world* world, const qv_collider* colliders, int count);
 /* Steps every instance once (asleep: none); returns how many reset (a blown-up state; never expected). */
