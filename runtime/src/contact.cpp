@@ -195,7 +195,6 @@ void surfacePoint(const qv_instance& s, int n, bool deformed, double out[3]) {
   }
 }
 
-
 // Signed distance of world point p to a body's rest surface carried by its frame; the surface
 // vertex nearest the closest point through `vertex`. False when beyond `reach`. With `facing` (a
 // world direction), to the surface facing against it only (qv_triangle_mesh::distance).
@@ -456,7 +455,6 @@ bool withinMargin(const ContactBody* bodies, int i, int j, double margin) {
   return norm3(gap) <= a.surfaceRadius + b.surfaceRadius + margin;
 }
 
-
 // How far from a surface a candidate can be and still be kept: a full list takes only those its
 // poorest would give way to (admit()), so the closest-point queries need not look farther (in a
 // pile of 320 bars they took half the step). Touching candidates (within the vertex's own slop,
@@ -665,8 +663,10 @@ bool boxesApart(const qv_instance& a, const qv_instance& b, double margin) {
   const double *Ra = a.frame.rotation, *Rb = b.frame.rotation;
   for (int i = 0; i < 3; ++i)  // C_ij = a's axis i . b's axis j
     for (int j = 0; j < 3; ++j) C[3 * i + j] = std::fabs(Ra[i] * Rb[j] + Ra[3 + i] * Rb[3 + j] + Ra[6 + i] * Rb[6 + j]) + 1e-9;
+  // Rounding: relative to the lengths compared and to the positions they were worked out from.
+  const double scale = norm3(a.frame.position) + norm3(b.frame.position);
   const auto apart = [&](double distance, double reachA, double reachB) {
-    return distance - reachA - reachB > margin + 1e-9 * (distance + reachA + reachB + margin) + 1e-12;
+    return distance - reachA - reachB > margin + 1e-9 * (distance + reachA + reachB + margin + scale) + 1e-12;
   };
   for (int i = 0; i < 3; ++i)
     if (apart(std::fabs(t[i]), extentA[i], extentB[0] * C[3 * i] + extentB[1] * C[3 * i + 1] + extentB[2] * C[3 * i + 2]))

@@ -82,11 +82,12 @@ bool colliderDistance(const qv_collider& collider, const double p[3], double rea
                       const double* facing = nullptr);
 bool validCollider(const qv_collider& collider);
 
-// Whether a's contact points (rest or, with soft contacts, deformed: qv_instance::surfaceLow), carried
-// by its frame, all lie farther than `margin` from b's rest surface: the boxes around them in their bodies' axes are farther apart than that along one
-// of the six face normals (the separating axes of two boxes that need no cross product), by more
-// than rounding. In a pile most bars near enough for their spheres are apart so, and each of a's
-// vertices would be a closest-point query that finds nothing.
+// Whether a's contact points (rest or, with soft contacts, deformed: qv_instance::surfaceLow),
+// carried by its frame, all lie farther than `margin` from b's rest surface: the boxes around them
+// in their bodies' axes are farther apart than that along one of the six face normals (the
+// separating axes of two boxes that need no cross product), by more than rounding. In a pile most
+// bars near enough for their spheres are apart so, and each of a's vertices would be a
+// closest-point query that finds nothing.
 bool boxesApart(const qv_instance& a, const qv_instance& b, double margin);
 // A soft body's contact points as its deformation places them, in its body axes, and their box
 // (qv_instance::deformedSurface, surfaceLow): once a contact search, not for each body it could touch.

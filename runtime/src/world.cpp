@@ -182,12 +182,14 @@ bool qv_world::restoreSnapshot(const double* in, size_t bytes) {
 
 void qv_world::remove(int i) {
   qv_instance& gone = *instances[i];
-  // What slept with it wakes (a stack whose lowest is taken away must fall); an awake instance has
-  // no sleeper's group id (wakeSleptWith()), so the ids above its index stay distinct one lower.
+  // What slept with it wakes (a stack whose lowest is taken away must fall), whether it still sleeps
+  // or the caller woke it since the last step (wakeSleptWith() would have woken them at the next).
+  // Then no sleeper keeps its index as a group's id (a group's id is its root's index when it fell
+  // asleep, and the root is in the group), so the ids above its index stay distinct one lower.
   for (int j = 0; j < count; ++j) {
     qv_instance& s = *instances[j];
     if (j == i || s.sleepGroup < 0) continue;
-    if (gone.asleep && s.sleepGroup == gone.sleepGroup) {
+    if (gone.sleepGroup >= 0 && s.sleepGroup == gone.sleepGroup) {
       s.wake(), s.sleepGroup = -1;
     } else if (s.sleepGroup > i) {
       --s.sleepGroup;

@@ -474,7 +474,8 @@ QV_API qv_result qv_world_add(qv_world* world, qv_instance* instance, int* index
 /* Takes an instance out (QV_ERROR_INVALID_ARGUMENT: not in it), as a game despawns an object; remove an
    instance before destroying it. The instances after it move down an index (as the last step's contacts
    name them); the others' contacts carry on; the instances it fell asleep with wake (what rested on it
-   falls). It keeps its state and pose, awake, and may be stepped alone or added again. */
+   falls). It keeps its state and pose, awake, and may be stepped alone or added again. A world snapshot
+   saved before names the instances as they were: restore it only into the same instances in the same order. */
 QV_API qv_result qv_world_remove(qv_world* world, qv_instance* instance);
 /* The world's colliders, kept by pointer as qv_instance_set_colliders keeps them; wakes every instance. */
 QV_API qv_result qv_world_set_colliders(qv_world* world, const qv_collider* colliders, int count);
