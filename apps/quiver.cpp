@@ -204,6 +204,8 @@ int main(int argc, char** argv) {
     }
     if (*render) return quiver::app::renderModel(path, renderOptions);
     if (*sim && crowd.instances > 0) return quiver::app::simulateCrowd(path, simOptions, crowd);
+    if (*sim && crowd.threads > 1 && simOptions.flight.pile <= 1) throw std::runtime_error("--threads needs --instances or --pile N");
+    simOptions.flight.threads = crowd.threads;
     if (*sim) return quiver::app::simulateModel(path, simOptions);
     const quiver::app::RuntimeModel model(path);
     const ordered_json out = *info ? describeModel(model) : evaluateModel(model, qText);

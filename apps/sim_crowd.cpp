@@ -29,10 +29,11 @@ void CrowdOptions::addTo(CLI::App& app) {
                  "the group of 2% of the model's weight turning about x from one to the next; reports frame times")
       ->check(CLI::Range(1, 1000000));
   CLI::Option* given = app.get_option("--instances");
-  app.add_option("--threads", threads, "With --instances: jobs on this many threads (the caller's included)")
+  app.add_option("--threads", threads,
+                 "With --instances, or --free --pile N (the bodies' own parts of each world step, qv_world_set_jobs): "
+                 "jobs on this many threads (the caller's included)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 256))
-      ->needs(given);
+      ->check(CLI::Range(1, 256));
   app.add_flag("--one-by-one", oneByOne, "With --instances: qv_instance_step on each instead, to compare")->needs(given);
 }
 

@@ -52,6 +52,7 @@ int simulateModel(const std::string& path, const SimOptions& o) {
                                                 s.linear_velocity[2] * s.linear_velocity[2]));
         }
         j["bodies"] = bodies.bodyCount();
+        j["threads"] = o.flight.threads;
         j["final_centers"] = centres;
         j["max_final_speed_mps"] = fastest;
         j["asleep_at_end"] = bodies.asleepCount();

@@ -553,19 +553,24 @@ steps every awake instance once and returns how many reset. The world keeps its 
           throw py::value_error("qv_world_set_colliders refused the colliders");
         self.colliders = std::move(set);
       }, py::arg("colliders"), "The world's colliders (a list; copied: to move one, pass a new list).")
-      .def("step", [](World& self) {
+      .def("step", [](World& self, int threads) {
+        if (threads < 1) throw py::value_error("threads must be at least 1");
         std::vector<Instance*> members;
         for (const py::object& s : self.instances) members.push_back(&s.cast<Instance&>());
         qv_world* world = self.use();
         BusyGuard guard(members);
+        const qv_job_runner runner{threads, runOnThreads, nullptr};
         struct Stepping {  // the world's own colliders and members must not change meanwhile
           World& w;
-          ~Stepping() { w.busy = false; }
+          ~Stepping() { w.busy = false, qv_world_set_jobs(w.get(), nullptr); }
         } stepping{self};
         self.busy = true;
+        if (threads > 1) qv_world_set_jobs(world, &runner);
         py::gil_scoped_release release;
         return qv_world_step(world);
-      }, "Steps every awake instance once; returns how many reset (never expected).")
+      }, py::arg("threads") = 1,
+           "Steps every awake instance once; returns how many reset (never expected). threads > 1 runs each "
+           "instance's own parts of the step on that many threads (made for the call; the same bits).")
       .def("contacts", [](const World& self) { return contactArray(static_cast<const qv_world*>(self.use()), qv_world_contacts); },
            "The last step's contacts, as Instance.contacts(); `instance` and `other` say who touched whom.")
       .def("save_snapshot", [](const World& self) {

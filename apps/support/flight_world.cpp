@@ -95,6 +95,11 @@ FlightWorld::FlightWorld(const RuntimeModel& model, const RuntimeInstance& first
     qv_world* world = nullptr;
     if (qv_world_create(&config, nullptr, &world) != QV_OK) throw std::runtime_error("--pile: out of memory");
     world_.reset(world);
+    if (o.threads > 1) {
+      pool_ = std::make_unique<JobPool>(o.threads);
+      runner_ = pool_->runner();
+      qv_world_set_jobs(world, &runner_);
+    }
   }
   for (int k = 0; k < count; ++k) {
     if (k > 0) copies_.push_back(std::make_unique<RuntimeInstance>(model, first.config()));

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "apps/support/collider_set.h"
+#include "apps/support/job_pool.h"
 #include "apps/support/runtime_model.h"
 
 namespace quiver::app {
@@ -23,6 +24,8 @@ struct FlightSetup {
   double friction = 0.5;                         // Coulomb mu of every collider (and between bodies)
   double restitution = 0.2;                      // of every collider (and between bodies), 0..1
   double sleepSpeed = 0;                         // --pile: qv_world_config.sleep_speed, m/s (0: never); the runtime's default
+  int threads = 1;                               // --pile: the world's jobs on this many threads (qv_world_set_jobs);
+                                                 // `quiver sim --threads` sets it, not addTo()
 
   FlightSetup();
 
@@ -59,6 +62,8 @@ private:
   };
   const RuntimeInstance& first_;
   std::vector<std::unique_ptr<RuntimeInstance>> copies_;
+  std::unique_ptr<JobPool> pool_;                  // with --threads above 1
+  qv_job_runner runner_{};                         // the world reads it by pointer
   std::unique_ptr<qv_world, WorldRelease> world_;  // with more than one body
   ColliderSet colliders_;                          // the instance or the world reads them by pointer
   std::vector<qv_contact> contacts_;

@@ -537,6 +537,12 @@ qv_result qv_world_set_colliders(qv_world* world, const qv_collider* colliders, 
   return QV_OK;
 }
 
+qv_result qv_world_set_jobs(qv_world* world, const qv_job_runner* jobs) {
+  if (!world || (jobs && (jobs->count < 1 || !jobs->run))) return QV_ERROR_INVALID_ARGUMENT;
+  world->jobs = jobs;
+  return QV_OK;
+}
+
 int qv_world_step(qv_world* world) { return world ? world->step() : 0; }
 
 int qv_instance_asleep(const qv_instance* s) { return s && s->asleep; }

@@ -840,7 +840,8 @@ void keepConsistentPushes(const ContactBody* bodies, ContactList& list, double h
 } // namespace
 
 void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* colliders, int colliderCount,
-                   const ContactMaterial& material, ContactList& list, double h, BroadPhase* broad) {
+                   const ContactMaterial& material, ContactList& list, double h, BroadPhase* broad,
+                   const qv_job_runner* jobs) {
   std::swap(list.contacts, list.previous);
   list.previousCount = list.count;
   list.count = 0;
@@ -1005,7 +1006,7 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     while (bodies[i].island != i) i = bodies[i].island = bodies[bodies[i].island].island;
     return i;
   };
-  for (int i = 0; i < bodyCount; ++i) bodies[i].island = i, bodies[i].islandBounces = bodies[i].islandSettled = false;
+  for (int i = 0; i < bodyCount; ++i) bodies[i].island = i, bodies[i].islandBounces = false;
   for (int j = 0; j < list.count; ++j)
     if (list.contacts[j].other >= 0) {
       const int a = islandOf(list.contacts[j].body), b = islandOf(list.contacts[j].other);
@@ -1013,56 +1014,76 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     }
   for (int i = 0; i < bodyCount; ++i) bodies[i].island = islandOf(i);
   for (int j = 0; j < list.count; ++j) bodies[bodies[list.contacts[j].body].island].islandBounces |= list.contacts[j].bounce > 0;
-  bool sweeping = true;
-  for (int sweep = 0; sweep < kSweeps && sweeping; ++sweep) {
-    for (int i = 0; i < bodyCount; ++i) bodies[i].islandMoved = false;
-    for (int j = 0; j < list.count; ++j) {
-      Contact& ct = list.contacts[j];
-      ContactBody& island = bodies[bodies[ct.body].island];
-      if (island.islandSettled) continue;
-      const double startNormal = ct.normalImpulse, startTangent[2] = {ct.tangentImpulse[0], ct.tangentImpulse[1]};
-      // Restitution once the contact holds: the last sweeps aim at the bounce, as fast away as the
-      // approach was times the restitution, where the impulse pushes (speculative contacts would
-      // otherwise stop the approach a step early and never bounce).
-      if (sweep == kSweeps / 2) {
-        ct.stopImpulse = ct.normalImpulse;
-        if (ct.normalImpulse > 0 && ct.bounce > 0) ct.target = std::fmax(ct.target, ct.bounce);
+  // Each island's contacts in the list's order (a counting sort by island), at list.order[first, end)
+  // of its root.
+  for (int i = 0; i < bodyCount; ++i) bodies[i].islandFirst = bodies[i].islandEnd = 0;
+  for (int j = 0; j < list.count; ++j) ++bodies[bodies[list.contacts[j].body].island].islandEnd;
+  for (int i = 0, at = 0; i < bodyCount; ++i) {
+    const int contacts = bodies[i].islandEnd;
+    bodies[i].islandFirst = bodies[i].islandEnd = at;
+    at += contacts;
+  }
+  for (int j = 0; j < list.count; ++j) list.order[bodies[bodies[list.contacts[j].body].island].islandEnd++] = j;
+  const auto sweepIsland = [&](ContactBody& island) {
+    for (int sweep = 0; sweep < kSweeps; ++sweep) {
+      bool moved = false;
+      for (int k = island.islandFirst; k < island.islandEnd; ++k) {
+        const int j = list.order[k];
+        Contact& ct = list.contacts[j];
+        const double startNormal = ct.normalImpulse, startTangent[2] = {ct.tangentImpulse[0], ct.tangentImpulse[1]};
+        // Restitution once the contact holds: the last sweeps aim at the bounce, as fast away as the
+        // approach was times the restitution, where the impulse pushes (speculative contacts would
+        // otherwise stop the approach a step early and never bounce).
+        if (sweep == kSweeps / 2) {
+          ct.stopImpulse = ct.normalImpulse;
+          if (ct.normalImpulse > 0 && ct.bounce > 0) ct.target = std::fmax(ct.target, ct.bounce);
+        }
+        double vel[3];
+        relativeVelocity(ct, vel);
+        // Normal: accumulated impulse >= 0. Slightly soft (compliance kSoftness / normalMass) up to
+        // the impulses resting takes: a resting face shares its weight among its contacts by how deep
+        // each is, rather than as the sweep order happens to (which dents a soft object under a few
+        // loaded vertices); an impact's impulse beyond that is stiff (softness let 10% of a landing's
+        // speed through: 5 mm in a step at 3 m/s).
+        const double before = ct.normalImpulse, soft = std::fmin(before, ct.restingImpulse);
+        const double stiff = ct.normalImpulse > ct.restingImpulse ? 1.0 : 1 + kSoftness;
+        ct.normalImpulse = std::fmax(0.0, before + (ct.target - dot3(vel, ct.normal) - kSoftness * soft / ct.normalMass) /
+                                                   (stiff / ct.normalMass));
+        const double push[3] = {ct.normalImpulse - before, 0, 0};
+        apply(j, push);
+        // Friction: the accumulated tangent impulse within the disc of radius mu * normal impulse.
+        relativeVelocity(ct, vel);
+        const double limit = ct.friction * ct.normalImpulse;
+        const double old[2] = {ct.tangentImpulse[0], ct.tangentImpulse[1]};
+        double next[2];
+        for (int t = 0; t < 2; ++t) next[t] = old[t] - ct.tangentMass[t] * dot3(vel, ct.tangent[t]);
+        const double size = std::sqrt(next[0] * next[0] + next[1] * next[1]);
+        if (size > limit) next[0] *= limit / size, next[1] *= limit / size;
+        const double rub[3] = {0, next[0] - old[0], next[1] - old[1]};
+        ct.tangentImpulse[0] = next[0], ct.tangentImpulse[1] = next[1];
+        apply(j, rub);
+        const double change = std::fabs(ct.normalImpulse - startNormal) + std::fabs(next[0] - startTangent[0]) +
+                              std::fabs(next[1] - startTangent[1]);
+        moved |= change > kConverged * ct.restingImpulse;
       }
-      double vel[3];
-      relativeVelocity(ct, vel);
-      // Normal: accumulated impulse >= 0. Slightly soft (compliance kSoftness / normalMass) up to
-      // the impulses resting takes: a resting face shares its weight among its contacts by how deep
-      // each is, rather than as the sweep order happens to (which dents a soft object under a few
-      // loaded vertices); an impact's impulse beyond that is stiff (softness let 10% of a landing's
-      // speed through: 5 mm in a step at 3 m/s).
-      const double before = ct.normalImpulse, soft = std::fmin(before, ct.restingImpulse);
-      const double stiff = ct.normalImpulse > ct.restingImpulse ? 1.0 : 1 + kSoftness;
-      ct.normalImpulse = std::fmax(0.0, before + (ct.target - dot3(vel, ct.normal) - kSoftness * soft / ct.normalMass) /
-                                                 (stiff / ct.normalMass));
-      const double push[3] = {ct.normalImpulse - before, 0, 0};
-      apply(j, push);
-      // Friction: the accumulated tangent impulse within the disc of radius mu * normal impulse.
-      relativeVelocity(ct, vel);
-      const double limit = ct.friction * ct.normalImpulse;
-      const double old[2] = {ct.tangentImpulse[0], ct.tangentImpulse[1]};
-      double next[2];
-      for (int t = 0; t < 2; ++t) next[t] = old[t] - ct.tangentMass[t] * dot3(vel, ct.tangent[t]);
-      const double size = std::sqrt(next[0] * next[0] + next[1] * next[1]);
-      if (size > limit) next[0] *= limit / size, next[1] *= limit / size;
-      const double rub[3] = {0, next[0] - old[0], next[1] - old[1]};
-      ct.tangentImpulse[0] = next[0], ct.tangentImpulse[1] = next[1];
-      apply(j, rub);
-      const double change = std::fabs(ct.normalImpulse - startNormal) + std::fabs(next[0] - startTangent[0]) +
-                            std::fabs(next[1] - startTangent[1]);
-      island.islandMoved |= change > kConverged * ct.restingImpulse;
+      if (!moved && (!island.islandBounces || sweep > kSweeps / 2)) return;
     }
-    sweeping = false;
-    for (int i = 0; i < bodyCount; ++i) {
-      ContactBody& b = bodies[i];
-      if (b.island != i || b.islandSettled) continue;
-      b.islandSettled = !b.islandMoved && (!b.islandBounces || sweep > kSweeps / 2);
-      sweeping |= !b.islandSettled;
-    }
+  };
+  // Islands touch no body in common, so they are swept in the caller's jobs (contiguous shares of
+  // the contacts, whole islands each) with the same bits.
+  const int jobCount = jobs && list.count > 1 ? std::min(jobs->count, list.count) : 1;
+  const auto sweepJob = [&](int job) {
+    for (int i = 0; i < bodyCount; ++i)
+      if (bodies[i].island == i && bodies[i].islandEnd > bodies[i].islandFirst &&
+          static_cast<long long>(bodies[i].islandFirst) * jobCount / list.count == job)
+        sweepIsland(bodies[i]);
+  };
+  if (jobCount > 1) {
+    using Job = decltype(sweepJob);
+    jobs->run(jobs->user, [](void* data, int job) { (*static_cast<const Job*>(data))(job); },
+              const_cast<void*>(static_cast<const void*>(&sweepJob)), jobCount);
+  } else {
+    sweepJob(0);
   }
   for (int i = 0; i < bodyCount; ++i) {
     std::memcpy(bodies[i].instance->frame.velocity, bodies[i].velocity, sizeof bodies[i].velocity);

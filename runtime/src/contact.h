@@ -53,10 +53,10 @@ struct ContactBody {
   double spin[3] = {};
   double inverseInertia[9] = {};
   // In the solve: the island it is in (the lowest index of the bodies its contacts join), and at an
-  // island's index whether one of its contacts bounces, whether the last sweep moved its impulses,
-  // and whether it has settled (no more sweeps).
+  // island's index whether one of its contacts bounces and where its contacts are in ContactList::order.
   int island = 0;
-  bool islandBounces = false, islandMoved = false, islandSettled = false;
+  bool islandBounces = false;
+  int islandFirst = 0, islandEnd = 0;
   int firstPair = 0, pairEnd = 0;  // its pairs in the contact list
   // Its group: the bodies it could touch in the step (either stopped), and the ones those could
   // touch. The fastest relative speed of one of them against what it could touch sets its
@@ -105,9 +105,10 @@ void takeMomenta(ContactBody* bodies, int count, const qv_collider* colliders, i
 // takeMomenta(), before the frames move; all bodies share the time step h. Sleeping
 // bodies (qv_instance::asleep, at rest) take no part: none may be within an awake body's reach
 // (wakeSleepers()). With `broad` (a world's), the pairs of bodies tested are its overlaps
-// (broad_phase.h); without, every pair.
+// (broad_phase.h); without, every pair. With `jobs`, the islands' sweeps run in them.
 void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* colliders, int colliderCount,
-                   const ContactMaterial& between, ContactList& list, double h, BroadPhase* broad = nullptr);
+                   const ContactMaterial& between, ContactList& list, double h, BroadPhase* broad = nullptr,
+                   const qv_job_runner* jobs = nullptr);
 
 // Wakes every sleeping body whose group (takeMomenta()'s, as the solve will group them) holds an
 // awake body or meets a moving collider, and every one within an awake body's margin; returns how

@@ -64,11 +64,12 @@ struct ContactPair {
 };
 
 // Where a solve puts its contacts: `contacts` this step's, `previous` the last step's (sorted by
-// key); two arrays of `capacity` that trade places each step; `turns` and `pairs`, `capacity` more.
+// key); two arrays of `capacity` that trade places each step; `turns`, `order` and `pairs`, `capacity` more.
 struct ContactList {
   Contact* contacts = nullptr;
   Contact* previous = nullptr;
   ContactTurns* turns = nullptr;  // contacts' (the solve's)
+  int* order = nullptr;           // the solve's: the contacts by island
   ContactPair* pairs = nullptr;
   int count = 0, previousCount = 0, capacity = 0;
   int pairCount = 0;

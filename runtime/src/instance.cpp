@@ -159,6 +159,7 @@ void qv_instance::carve(quiver::rt::BlockCarver& c) {
     contacts.contacts = c.take<quiver::rt::Contact>(static_cast<size_t>(config.max_contacts));
     contacts.previous = c.take<quiver::rt::Contact>(static_cast<size_t>(config.max_contacts));
     contacts.turns = c.take<quiver::rt::ContactTurns>(static_cast<size_t>(config.max_contacts));
+    contacts.order = c.take<int>(static_cast<size_t>(config.max_contacts));
     contacts.pairs = c.take<quiver::rt::ContactPair>(static_cast<size_t>(config.max_contacts));
     contacts.capacity = config.max_contacts;
   }

@@ -52,6 +52,7 @@ size_t layOut(const qv_world_config& config, char* block, qv_world** world) {
   Contact* contacts = c.take<Contact>(static_cast<size_t>(config.max_contacts));
   Contact* previous = c.take<Contact>(static_cast<size_t>(config.max_contacts));
   ContactTurns* turns = c.take<ContactTurns>(static_cast<size_t>(config.max_contacts));
+  int* order = c.take<int>(static_cast<size_t>(config.max_contacts));
   ContactPair* pairs = c.take<ContactPair>(static_cast<size_t>(config.max_contacts));
   if (block) {
     w = new (w) qv_world{};
@@ -63,6 +64,7 @@ size_t layOut(const qv_world_config& config, char* block, qv_world** world) {
     w->contacts.contacts = contacts;
     w->contacts.previous = previous;
     w->contacts.turns = turns;
+    w->contacts.order = order;
     w->contacts.pairs = pairs;
     w->contacts.capacity = config.max_contacts;
     *world = w;
@@ -105,14 +107,40 @@ void destroyWorld(qv_world* world) {
 
 } // namespace quiver::rt
 
+void qv_world::forEachInstance(void (*part)(qv_world&, int)) {
+  struct Work {
+    qv_world* world;
+    void (*part)(qv_world&, int);
+    int jobs;
+  } work{this, part, jobs ? jobs->count : 1};
+  const auto runJob = [](void* data, int job) {
+    const Work& w = *static_cast<const Work*>(data);
+    if (job < 0 || job >= w.jobs) return;
+    const int n = w.world->count;
+    const int first = static_cast<int>(static_cast<long long>(n) * job / w.jobs);
+    const int end = static_cast<int>(static_cast<long long>(n) * (job + 1) / w.jobs);
+    for (int i = first; i < end; ++i) w.part(*w.world, i);
+  };
+  if (work.jobs > 1) {
+    jobs->run(jobs->user, runJob, &work, work.jobs);
+  } else {
+    runJob(&work, 0);
+  }
+}
+
 int qv_world::step() {
   if (!count) return 0;
   const double h = instances[0]->config.time_step;
   for (int i = 0; i < count; ++i) bodies[i].instance = instances[i];
   wakeSleptWith();
+  // Each instance's own parts of the step (its frame's forces; after the solve its move and
+  // deformation) touch that instance alone, so they run in the caller's jobs, with the same bits (as
+  // do the solve's islands).
+  forEachInstance([](qv_world& w, int i) {
+    if (!w.instances[i]->asleep) w.begin(i);
+  });
   int awake = 0;
-  for (int i = 0; i < count; ++i)
-    if (!instances[i]->asleep) begin(i), ++awake;
+  for (int i = 0; i < count; ++i) awake += !instances[i]->asleep;
   quiver::rt::takeMomenta(bodies, count, colliders, colliderCount, h, &broad);
   // Woken bodies start their step and may reach other sleepers in it.
   while (awake < count && quiver::rt::wakeSleepers(bodies, count, h, &broad)) {
@@ -122,13 +150,15 @@ int qv_world::step() {
   }
   const quiver::rt::ContactMaterial between{config.friction, config.restitution};
   if (awake) {
-    quiver::rt::solveContacts(bodies, count, colliders, colliderCount, between, contacts, h, &broad);
+    quiver::rt::solveContacts(bodies, count, colliders, colliderCount, between, contacts, h, &broad, jobs);
   } else {
     contacts.clear();
   }
+  forEachInstance([](qv_world& w, int i) {
+    w.slots[i].reset = !w.instances[i]->asleep && w.instances[i]->finishStep() == QV_STEP_RESET;
+  });
   int resets = 0;
-  for (int i = 0; i < count; ++i)
-    if (!instances[i]->asleep) resets += instances[i]->finishStep() == QV_STEP_RESET;
+  for (int i = 0; i < count; ++i) resets += slots[i].reset;
   settle(h);
   return resets;
 }

@@ -9,6 +9,7 @@ namespace quiver::rt {
 // shortest still time (qv_instance::stillTime).
 struct WorldSlot {
   bool begun = false;
+  bool reset = false;  // its step's end reset it (a blown-up state)
   double groupStill = 0;
 };
 
@@ -25,6 +26,10 @@ struct qv_world {
   quiver::rt::ContactList contacts;
   const qv_collider* colliders = nullptr;  // the caller's (qv_world_set_colliders)
   int colliderCount = 0;
+  const qv_job_runner* jobs = nullptr;     // the caller's (qv_world_set_jobs); null: the calling thread
+
+  // Calls part(i) for each i in [0, count), in jobs' contiguous ranges when the world has jobs.
+  void forEachInstance(void (*part)(qv_world&, int));
 
   // Each awake instance's frame forces, one contact solve over all, then each move and deformation;
   // then the groups that have been still long enough fall asleep.

@@ -150,6 +150,10 @@ class FreeFlight(unittest.TestCase):
         # --pca-amplitude 0.29, 0.31 or 1 (2026-11-29).
         j, sleeping = pile("--sleep-speed", 0), pile()
         self.assertEqual((j["asleep_at_end"], sleeping["asleep_at_end"]), (0, 20))
+        # The bodies' own parts of each world step on two threads (qv_world_set_jobs): the same bits.
+        threads = pile("--sleep-speed", 0, "--threads", 2)
+        self.assertEqual((j["threads"], threads["threads"]), (1, 2))
+        self.assertEqual(threads["final_centers"], j["final_centers"])
         self.assertLess(np.abs(np.array(j["final_centers"]) - np.array(sleeping["final_centers"])).max(), 0.002)
         heights = sorted(c[2] for c in j["final_centers"])
         print(f"pile of {j['bodies']}: fastest {j['max_final_speed_mps']:.2g} m/s after 8 s, centres {heights[0]:.3f} to "
@@ -250,6 +254,8 @@ class FreeFlight(unittest.TestCase):
         for option in (["--spread"], ["--sleep-speed", "0"]):
             p = run(QUIVER, "sim", self.free + ".qvr", "--free", *option, "--steps", 2, codes=(1,))
             self.assertIn("need --pile N", p.stderr)
+        p = run(QUIVER, "sim", self.free + ".qvr", "--free", "--threads", 2, "--steps", 2, codes=(1,))
+        self.assertIn("--threads needs --instances or --pile N", p.stderr)
         for option in ("--sleep-speed", "--friction"):
             p = run(QUIVER, "sim", self.free + ".qvr", "--free", "--pile", 2, option, "-1", "--steps", 2, codes=(105,))
             self.assertIn(f"{option}: expected a number >= 0, not '-1'", p.stderr)

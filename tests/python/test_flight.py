@@ -191,9 +191,9 @@ def test_a_world_snapshot_rewinds_a_stack_landing_bit_for_bit(free_model):
     world.add(low), world.add(high)
     world.set_colliders([quiver.Plane((0, 0, 1), 0.0)])
 
-    def run(steps):
+    def run(steps, threads=1):
         for _ in range(steps):
-            assert world.step() == 0
+            assert world.step(threads=threads) == 0
         return [s.positions() for s in world.instances], world.contacts(), [s.asleep for s in world.instances]
 
     run(20)  # the upper is landing on the lower
@@ -202,7 +202,7 @@ def test_a_world_snapshot_rewinds_a_stack_landing_bit_for_bit(free_model):
     assert isinstance(snapshot, bytes)
     first = run(60)
     world.restore_snapshot(snapshot)
-    again = run(60)
+    again = run(60, threads=2)  # the same bits on two threads too
     for a, b in zip(first[0], again[0]):
         np.testing.assert_array_equal(a, b)
     np.testing.assert_array_equal(first[1], again[1])

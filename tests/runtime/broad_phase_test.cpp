@@ -141,6 +141,7 @@ TEST(BroadPhase, AContactSolveFindsWhatTestingEveryPairFinds) {
       std::vector<ContactBody> bodies[2];
       std::vector<Contact> contacts[2], previous[2];
       std::vector<ContactTurns> turns[2];
+      std::vector<int> order[2];
       std::vector<ContactPair> pairs[2];
       ContactList lists[2];
       for (int set = 0; set < 2; ++set) {
@@ -155,9 +156,9 @@ TEST(BroadPhase, AContactSolveFindsWhatTestingEveryPairFinds) {
           bodies[set][i].instance = s;
         }
         contacts[set].resize(capacity), previous[set].resize(capacity), pairs[set].resize(capacity);
-        turns[set].resize(capacity);
+        turns[set].resize(capacity), order[set].resize(capacity);
         lists[set].contacts = contacts[set].data(), lists[set].previous = previous[set].data();
-        lists[set].turns = turns[set].data();
+        lists[set].turns = turns[set].data(), lists[set].order = order[set].data();
         lists[set].pairs = pairs[set].data(), lists[set].capacity = capacity;
       }
       Scene broad(n);

@@ -13,8 +13,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <random>
+#include <thread>
 #include <vector>
 
 #include "free_bar.h"
@@ -850,6 +852,77 @@ TEST(World, WithSoftContactsASoftBarLiesStraightOnASlab) {
       EXPECT_LT(slabFastest, 1e-5);
     }
   }
+}
+
+// A world's instances' own parts of its steps and its solve's islands run in the caller's jobs
+// (qv_world_set_jobs): twenty bars dropped into a bin (islands that merge as they land) and sixteen
+// dropped apart on a grid (an island each), with sleeping on, stepped in three jobs run backwards
+// on the calling thread and in two jobs on two threads, end bit for bit where one thread leaves
+// them, contacts and sleep included.
+TEST(World, StepsInJobsGiveTheSameBits) {
+  FreeBar bar(16, {12, 2, 2});
+  const double h = 1.0 / 60;
+  struct Backwards {
+    static void run(void*, qv_job_function job, void* data, int count) {
+      for (int i = count - 1; i >= 0; --i) job(data, i);
+    }
+  };
+  struct Threads {
+    static void run(void*, qv_job_function job, void* data, int count) {
+      std::vector<std::thread> others;
+      for (int i = 1; i < count; ++i) others.emplace_back(job, data, i);
+      job(data, 0);
+      for (std::thread& t : others) t.join();
+    }
+  };
+  const qv_job_runner backwards{3, Backwards::run, nullptr}, threads{2, Threads::run, nullptr};
+  const auto dropApart = [&](World& world) {
+    world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0)};
+    world.setColliders();
+    for (int k = 0; k < 16; ++k) {
+      qv_rigid_state s = at(0.8 * (k % 4), 0.8 * (k / 4), 0.1 + 0.05 * (k % 5));
+      s.orientation[0] = std::cos(0.1 * k), s.orientation[1] = std::sin(0.1 * k);  // tilted: each lands its own way
+      world.add(bar, h, s, true);
+    }
+  };
+  for (const bool apart : {false, true}) {
+    World one(0.5, 0, 4096, kSleepSpeed), three(0.5, 0, 4096, kSleepSpeed), two(0.5, 0, 4096, kSleepSpeed);
+    ASSERT_EQ(qv_world_set_jobs(three.w, &backwards), QV_OK);
+    ASSERT_EQ(qv_world_set_jobs(two.w, &threads), QV_OK);
+    for (World* w : {&one, &three, &two}) {
+      if (apart) {
+        dropApart(*w);
+      } else {
+        dropTwentyIntoABin(*w, bar, h);
+      }
+    }
+    const int n = static_cast<int>(one.bodies.size());
+    const auto compare = [&](int steps) {
+      for (World* w : {&one, &three, &two})
+        for (int i = 0; i < steps; ++i) ASSERT_EQ(qv_world_step(w->w), 0);
+      for (const World* w : {&three, &two}) {
+        for (int k = 0; k < n; ++k) EXPECT_EQ(bar.positions(w->bodies[k]->s), bar.positions(one.bodies[k]->s)) << "bar " << k;
+        EXPECT_EQ(asleep(*w), asleep(one));
+        const std::vector<qv_contact> x = w->contacts(), y = one.contacts();
+        ASSERT_EQ(x.size(), y.size());
+        for (size_t k = 0; k < x.size(); ++k) EXPECT_EQ(std::memcmp(&x[k], &y[k], sizeof x[k]), 0) << "contact " << k;
+      }
+    };
+    compare(30);  // landing
+    const size_t landing = one.contacts().size();
+    compare(270);
+    std::printf("%d bars %s, in jobs as on one thread: %zu contacts after 0.5 s; %d asleep after 5 s\n", n,
+                apart ? "dropped apart" : "in a bin", landing, asleep(one));
+    EXPECT_GT(landing, 100u);
+    EXPECT_GT(asleep(one), 0);
+  }
+  World world;
+  const qv_job_runner none{0, Backwards::run, nullptr}, runless{2, nullptr, nullptr};
+  EXPECT_EQ(qv_world_set_jobs(world.w, &none), QV_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(qv_world_set_jobs(world.w, &runless), QV_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(qv_world_set_jobs(nullptr, &threads), QV_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(qv_world_set_jobs(world.w, &threads), QV_OK);
+  EXPECT_EQ(qv_world_set_jobs(world.w, nullptr), QV_OK);  // back to the calling thread
 }
 
 TEST(World, BadUseIsRefused) {

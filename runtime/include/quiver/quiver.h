@@ -481,6 +481,14 @@ QV_API qv_result qv_world_remove(qv_world* world, qv_instance* instance);
 QV_API qv_result qv_world_set_colliders(qv_world* world, const qv_collider* colliders, int count);
 /* Steps every instance once (asleep: none); returns how many reset (a blown-up state; never expected). */
 QV_API int qv_world_step(qv_world* world);
+/* More cores for a world's steps (the runtime starts no threads): each instance's own parts of a step (its
+   frame's forces, and after the contact solve its move and deformation) run as jobs->count jobs over
+   contiguous ranges of the instances, and the contact solve's sweeps as jobs over its islands (the bodies
+   its contacts join, which share nothing), as qv_instances_step runs its jobs (jobs->run must call
+   job(job_data, i) once for each i, on any threads, and return when all have run); finding the contacts
+   stays on the calling thread. The same bits whatever the jobs. Kept by pointer; NULL (the default): all
+   on the calling thread. QV_ERROR_INVALID_ARGUMENT: count < 1 or no run function. */
+QV_API qv_result qv_world_set_jobs(qv_world* world, const qv_job_runner* jobs);
 /* Whether an instance is asleep in its world (0 outside a world), and waking it (with the group it slept with). */
 QV_API int qv_instance_asleep(const qv_instance* instance);
 QV_API void qv_instance_wake(qv_instance* instance);
