@@ -13,10 +13,15 @@ which give way where they push).
     /usr/bin/python3 bench/world.py --build build/release [--piles 20,80,320] [--spread 1024] [--contacts rigid,soft]
 
 With --against QUIVER (another build's `quiver`, e.g. one built at an earlier commit), compares the
-two instead, kept awake (`--sleep-speed 0`), rigid contacts: each pile, the spread and one bar
-resting alone (no world), --runs alternated runs of --steps steps each, their medians and ratio.
+two instead, kept awake (`--sleep-speed 0`), with each of --contacts: each pile, the spread and one
+bar resting alone (no world), --runs alternated runs of --steps steps each, their medians and ratio.
 
     /usr/bin/python3 bench/world.py --build build/release --against /tmp/quiver_before [--runs 3] [--steps 600]
+
+With --threads T, compares the build's world steps on one thread and on T (`quiver sim --threads`,
+qv_world_set_jobs) the same way, the piles and the spread only.
+
+    /usr/bin/python3 bench/world.py --build build/release --threads 2 [--runs 3] [--steps 600]
 """
 import statistics
 import argparse
@@ -38,6 +43,7 @@ def main():
     ap.add_argument("--spread", type=int, default=1024)
     ap.add_argument("--contacts", default="rigid,soft", help="comma-separated: rigid (the default contacts), soft")
     ap.add_argument("--against", help="another build's quiver binary: compare the two (see above)")
+    ap.add_argument("--threads", type=int, help="compare one thread against this many (see above)")
     ap.add_argument("--runs", type=int, default=3, help="with --against: alternated runs of each")
     ap.add_argument("--steps", type=int, default=STEPS, help="steps of 1/60 s a run")
     args = ap.parse_args()
@@ -52,8 +58,13 @@ def main():
         subprocess.run(["mpirun", "-n", "2", os.path.join(apps, "quiver-bake"), mesh, "--modes", "10", "--rank", "16",
                         "--quiet", "-o", bar], check=True, env=ENV, stdin=subprocess.DEVNULL, capture_output=True)
         worlds = [(int(x), []) for x in args.piles.split(",")] + [(args.spread, ["--spread"])]
+        quiver = os.path.join(apps, "quiver")
         if args.against:
-            return compare(args, bar + ".qvr", os.path.join(apps, "quiver"), worlds)
+            return compare(args, bar + ".qvr", worlds + [("one bar alone", None)],
+                           [(args.against, args.against, []), (quiver, quiver, [])])
+        if args.threads:
+            return compare(args, bar + ".qvr", worlds,
+                           [("1 thread", quiver, []), (f"{args.threads} threads", quiver, ["--threads", str(args.threads)])])
         for n, layout in worlds:
             for contacts in args.contacts.split(","):
                 for sleep in ("0", "0.02"):
@@ -77,24 +88,32 @@ def main():
               f"| {j['max_penetration_m'] * 1e3:.0f} | {j['resets']} |")
 
 
-def compare(args, model, quiver, worlds):
-    """--against: each world (awake, rigid contacts) and one bar alone, both builds alternated."""
-    cases = [(f"{n} apart" if layout else f"pile of {n}", ["--pile", str(n), *layout, "--sleep-speed", "0"])
-             for n, layout in worlds] + [("one bar alone", [])]
-    print(machine_line() + f"; one thread, {args.steps} steps of 1/60 s, {args.runs} alternated runs each, medians\n")
-    print(f"| world | {args.against} (ms) | {quiver} (ms) | ratio |")
+def compare(args, model, worlds, sides):
+    """--against or --threads: each world (kept awake; ("one bar alone", None): one bar resting, no
+    world) with each kind of contacts, the two sides alternated. sides: (label, quiver, options) twice."""
+    cases = []
+    for contacts in args.contacts.split(","):
+        soft = ["--soft-contacts"] if contacts == "soft" else []
+        for n, layout in worlds:
+            if layout is None:
+                name, options = n, []
+            else:
+                name, options = f"{n} apart" if layout else f"pile of {n}", ["--pile", str(n), *layout, "--sleep-speed", "0"]
+            cases.append((f"{name}, {contacts} contacts", options + soft))
+    print(machine_line() + f"; {args.steps} steps of 1/60 s, {args.runs} alternated runs each, medians\n")
+    print(f"| world | {sides[0][0]} (ms) | {sides[1][0]} (ms) | ratio |")
     print("|---|---:|---:|---:|")
     for name, options in cases:
-        times = {args.against: [], quiver: []}
+        times = [[], []]
         for _ in range(args.runs):
-            for binary in times:
-                sim = subprocess.run([binary, "sim", model, "--free", "--gravity", *options, "--position", "0,0,0.2",
+            for k, (label, binary, extra) in enumerate(sides):
+                sim = subprocess.run([binary, "sim", model, "--free", "--gravity", *options, *extra, "--position", "0,0,0.2",
                                       "--collider", "plane:0,0,1,0", "--steps", str(args.steps), "--json"],
                                      capture_output=True, text=True, stdin=subprocess.DEVNULL)
                 if sim.returncode not in (0, 2):
-                    raise SystemExit(f"{binary} sim ({name}) failed ({sim.returncode}): {sim.stderr.strip()}")
-                times[binary].append(json.loads(sim.stdout)["step_us_median"] / 1e3)
-        before, after = statistics.median(times[args.against]), statistics.median(times[quiver])
+                    raise SystemExit(f"{label} sim ({name}) failed ({sim.returncode}): {sim.stderr.strip()}")
+                times[k].append(json.loads(sim.stdout)["step_us_median"] / 1e3)
+        before, after = statistics.median(times[0]), statistics.median(times[1])
         print(f"| {name} | {before:.3f} | {after:.3f} | {after / before:.2f} |")
 
 
