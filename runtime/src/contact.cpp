@@ -1120,7 +1120,8 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
       s.loads.addVertexForce(*s.model, s.config.elasticity, s.q, vertex, local);
     };
     load(ct.body, ct.vertex, 1);
-    if (ct.other >= 0) load(ct.other, ct.otherVertex, -1);
+    bodies[ct.body].instance->touching = true;
+    if (ct.other >= 0) load(ct.other, ct.otherVertex, -1), bodies[ct.other].instance->touching = true;
   }
 }
 

@@ -236,6 +236,7 @@ void qv_instance::setGravity(const double g[3]) {
 void qv_instance::beginStep() {
   lastStep = qv_step_report{};
   softContact = false;
+  touching = false;
   if (!flying()) return;
   const double h = config.time_step;
   frame.refresh(*model, q, v);
@@ -359,7 +360,7 @@ void qv_instance::takeOutTurnExcess(bool betweenSubsteps) {
   // substeps the contacts have acted (on the frame, at the step's start): settled there whatever is
   // in reach, or a bar spun at 500 rad/s tumbling on the ground gained 5%
   // (FreeFlight.FastSpinsBesideTheGroundNeverGainEnergy).
-  if ((!betweenSubsteps && contacts.count > 0) || frame.spinChangedSinceHold()) {
+  if ((!betweenSubsteps && touching) || frame.spinChangedSinceHold()) {
     frame.turnCredit = 0;
     return;
   }

@@ -135,6 +135,9 @@ struct qv_instance {
   double* modeVelocity = nullptr;
   // This step's contact solve let its deformation give way (soft contacts touching it, or within reach).
   bool softContact = false;
+  // This step's contact solve held a contact of its own or against its surface (alone or in a world,
+  // whose contacts are the world's).
+  bool touching = false;
 
   void carve(quiver::rt::BlockCarver& c);
   // The fixed Newton account at this state, E(q) = `elastic`, with the energy slack kept.

@@ -712,6 +712,41 @@ TEST(World, ABarComingToRestIsSolvedAsIfAloneBesideABusyOne) {
   EXPECT_GT(busy.position[0], 4);  // it slid on
 }
 
+// A world of one steps its bar as the bar steps alone, bit for bit, while it lands tumbling, bounces
+// and comes to rest: the same contacts, and the same turns settled (qv_instance::takeOutTurnExcess,
+// which leaves a body with contacts in reach alone; until 2026-11-29 it read the instance's own
+// contacts, which a world member never holds, and settled the world's bars in contact: the two
+// ended 1.6e-5 m apart).
+TEST(World, AWorldOfOneStepsItsBarAsTheBarStepsAlone) {
+  FreeBar bar;
+  const double h = 1.0 / 60;
+  const qv_collider ground = makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0.3);
+  qv_rigid_state thrown = at(0, 0, 0.4, 1);
+  thrown.angular_velocity[0] = 4, thrown.angular_velocity[1] = 9;
+  World world;
+  world.colliders = {ground};
+  world.setColliders();
+  qv_instance* member = world.add(bar, h, thrown, true);
+  qv_instance_config c = bar.config(h);
+  c.rayleigh_alpha = 5;  // as World::add
+  test::Instance alone(bar.model, c);
+  ASSERT_EQ(qv_instance_set_rigid_state(alone.s, &thrown), QV_OK);
+  const double g[3] = {0, 0, -kG};
+  qv_instance_set_gravity(alone.s, g);
+  ASSERT_EQ(qv_instance_set_colliders(alone.s, &ground, 1), QV_OK);
+  int touching = 0;
+  for (int i = 0; i < 240; ++i) {
+    ASSERT_EQ(qv_world_step(world.w), 0);
+    ASSERT_NE(qv_instance_step(alone.s), QV_STEP_RESET);
+    touching += !world.contacts().empty();
+  }
+  const double apart = (bar.positions(member) - bar.positions(alone.s)).cwiseAbs().maxCoeff();
+  std::printf("a bar thrown onto the ground, in a world of one and alone: %d steps with contacts, %.1e m apart at the end\n",
+              touching, apart);
+  EXPECT_GT(touching, 120);
+  EXPECT_EQ(apart, 0.0);
+}
+
 // A still bar beside a kinematic ball that spins within its reach, not touching it: it would be
 // woken at once, so it stays awake (it fell asleep and woke every half second, restarting its
 // contacts' impulses each time); once the ball stops it sleeps.
