@@ -30,8 +30,8 @@ void CrowdOptions::addTo(CLI::App& app) {
       ->check(CLI::Range(1, 1000000));
   CLI::Option* given = app.get_option("--instances");
   app.add_option("--threads", threads,
-                 "With --instances, or --free --pile N (the bodies' own parts of each world step, qv_world_set_jobs): "
-                 "jobs on this many threads (the caller's included)")
+                 "With --instances, or --free --pile N (each body's own parts of each world step and the contact "
+                 "solve's islands, qv_world_set_jobs): jobs on this many threads (the caller's included)")
       ->capture_default_str()
       ->check(CLI::Range(1, 256));
   app.add_flag("--one-by-one", oneByOne, "With --instances: qv_instance_step on each instead, to compare")->needs(given);

@@ -47,6 +47,8 @@ def main():
     ap.add_argument("--runs", type=int, default=3, help="with --against: alternated runs of each")
     ap.add_argument("--steps", type=int, default=STEPS, help="steps of 1/60 s a run")
     args = ap.parse_args()
+    if args.against and args.threads:
+        ap.error("--against and --threads: one comparison at a time")
     if not set(args.contacts.split(",")) <= {"rigid", "soft"}:
         ap.error(f"--contacts: expected rigid, soft or rigid,soft, not '{args.contacts}'")
     apps = os.path.join(args.build, "apps")

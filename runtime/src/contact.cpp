@@ -1070,8 +1070,10 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     }
   };
   // Islands touch no body in common, so they are swept in the caller's jobs (contiguous shares of
-  // the contacts, whole islands each) with the same bits.
-  const int jobCount = jobs && list.count > 1 ? std::min(jobs->count, list.count) : 1;
+  // the contacts, whole islands each) with the same bits; one island (a pile) on the calling thread.
+  int islands = 0;
+  for (int i = 0; i < bodyCount && islands < 2; ++i) islands += bodies[i].island == i && bodies[i].islandEnd > bodies[i].islandFirst;
+  const int jobCount = jobs && islands > 1 ? jobs->count : 1;
   const auto sweepJob = [&](int job) {
     for (int i = 0; i < bodyCount; ++i)
       if (bodies[i].island == i && bodies[i].islandEnd > bodies[i].islandFirst &&

@@ -150,7 +150,8 @@ class FreeFlight(unittest.TestCase):
         # --pca-amplitude 0.29, 0.31 or 1 (2026-11-29).
         j, sleeping = pile("--sleep-speed", 0), pile()
         self.assertEqual((j["asleep_at_end"], sleeping["asleep_at_end"]), (0, 20))
-        # The bodies' own parts of each world step on two threads (qv_world_set_jobs): the same bits.
+        # Each body's own parts of each world step and the solve's islands on two threads
+        # (qv_world_set_jobs): the same bits.
         threads = pile("--sleep-speed", 0, "--threads", 2)
         self.assertEqual((j["threads"], threads["threads"]), (1, 2))
         self.assertEqual(threads["final_centers"], j["final_centers"])
