@@ -196,10 +196,11 @@ void surfacePoint(const qv_instance& s, int n, bool deformed, double out[3]) {
 }
 
 // Signed distance of world point p to a body's rest surface carried by its frame; the surface
-// vertex nearest the closest point through `vertex`. False when beyond `reach`. With `facing` (a
-// world direction), to the surface facing against it only (qv_triangle_mesh::distance).
+// vertex nearest the closest point through `vertex`, the triangle through `nearest`. False when
+// beyond `reach`. With `facing` (a world direction), to the surface facing against it only; `hint`,
+// a triangle likely nearest (qv_triangle_mesh::distance).
 bool bodyDistance(const qv_instance& s, const double p[3], double reach, double& distance, double normal[3], int* vertex,
-                  const double* facing = nullptr) {
+                  const double* facing = nullptr, int* nearest = nullptr, int hint = -1) {
   const qv_model& m = *s.model;
   double rel[3], local[3], n[3], localFacing[3];
   for (int a = 0; a < 3; ++a) rel[a] = p[a] - s.frame.position[a];
@@ -207,7 +208,8 @@ bool bodyDistance(const qv_instance& s, const double p[3], double reach, double&
   for (int a = 0; a < 3; ++a) local[a] += m.rigidBody[a];  // the mesh is in the model's rest coordinates
   if (facing) s.frame.toBody(facing, localFacing);
   int triangle = 0;
-  if (!m.surfaceMesh->distance(local, reach, distance, n, &triangle, facing ? localFacing : nullptr)) return false;
+  if (!m.surfaceMesh->distance(local, reach, distance, n, &triangle, facing ? localFacing : nullptr, hint)) return false;
+  if (nearest) *nearest = triangle;
   s.frame.toWorldDirection(n, normal);
   if (vertex) {
     double best = INFINITY;
@@ -588,7 +590,8 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
     int otherVertex = 0;
     surfacePoint(a, n, softA, p);
     const double reach = keptReach(list, margin, a.contactSlop);
-    if (!bodyDistance(b, p, reach, depth, normal, &otherVertex) || depth > reach) continue;
+    int nearest = 0, facingNearest = 0;  // the triangles the queries found: hints for the deformed vertex's
+    if (!bodyDistance(b, p, reach, depth, normal, &otherVertex, nullptr, &nearest) || depth > reach) continue;
     const double arm = distance3(p, a.frame.position);
     // b's rest surface stays within its radius of b's centre; a's vertex closes on that centre by
     // the frames' travel and its own swing, at most twice its arm (the chord).
@@ -599,7 +602,7 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
     double own[3];
     int facingVertex = 0;
     const bool facing = pressFacing(a, v, margin, h, depth, normal, own, [&](double& d, double nf[3]) {
-      return bodyDistance(b, p, margin, d, nf, &facingVertex, own);
+      return bodyDistance(b, p, margin, d, nf, &facingVertex, own, &facingNearest);
     });
     if (facing) otherVertex = facingVertex;
     const auto moved = [&] {  // b's nearest vertex along the normal
@@ -619,7 +622,8 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
     if (!softA) {
       double deformed[3], ignored[3];
       worldVertex(a, v, true, deformed);
-      bodyDistance(b, deformed, INFINITY, ct->deformedDepth, ignored, nullptr, facing ? own : nullptr);
+      bodyDistance(b, deformed, INFINITY, ct->deformedDepth, ignored, nullptr, facing ? own : nullptr, nullptr,
+                   facing ? facingNearest : nearest);
       ct->deformedDepth -= moved();
     } else if (!softB) {
       ct->deformedDepth -= moved();

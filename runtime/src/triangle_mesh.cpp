@@ -268,7 +268,7 @@ void destroyTriangleMesh(qv_triangle_mesh* mesh) {
 } // namespace quiver::rt
 
 bool qv_triangle_mesh::distance(const double p[3], double reach, double& signedDistance, double normal[3], int* triangle,
-                                const double* facing) const {
+                                const double* facing, int hint) const {
   using namespace quiver::rt;
   const double rootDistance2 = boxDistance2(nodes[0], p);
   if (rootDistance2 > reach * reach) return false;
@@ -283,21 +283,22 @@ bool qv_triangle_mesh::distance(const double p[3], double reach, double& signedD
   stack[depth++] = {0, rootDistance2};
   double best = INFINITY, closest[3] = {};
   int bestTriangle = 0, bestFeature = 6;
+  const auto measure = [&](int t) {
+    if (facing && dot3(faceNormals + 3 * t, facing) >= 0) return;
+    const int* tri = triangles + 3 * t;
+    double c[3];
+    const int feature = closestOnTriangle(p, vertices + 3 * tri[0], vertices + 3 * tri[1], vertices + 3 * tri[2], c);
+    const double d[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+    const double d2 = dot3(d, d);
+    if (d2 < best) best = d2, bestTriangle = t, bestFeature = feature, std::memcpy(closest, c, sizeof c);
+  };
+  if (hint >= 0 && hint < triangleCount) measure(hint);
   while (depth) {
     const Pending pending = stack[--depth];
     if (pending.distance2 >= best) continue;
     const BvhNode& node = nodes[pending.node];
     if (node.count) {
-      for (int i = node.first; i < node.first + node.count; ++i) {
-        const int t = order[i];
-        if (facing && dot3(faceNormals + 3 * t, facing) >= 0) continue;
-        const int* tri = triangles + 3 * t;
-        double c[3];
-        const int feature = closestOnTriangle(p, vertices + 3 * tri[0], vertices + 3 * tri[1], vertices + 3 * tri[2], c);
-        const double d[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
-        const double d2 = dot3(d, d);
-        if (d2 < best) best = d2, bestTriangle = t, bestFeature = feature, std::memcpy(closest, c, sizeof c);
-      }
+      for (int i = node.first; i < node.first + node.count; ++i) measure(order[i]);
       continue;
     }
     const Pending first = {node.first, boxDistance2(nodes[node.first], p)};

@@ -34,9 +34,11 @@ struct qv_triangle_mesh {
   // than `reach` outside the mesh's bounding box (nothing computed). `triangle`, when not null,
   // receives the closest triangle. With `facing` (a unit direction), only the triangles facing
   // against it count: the distance to the nearest of them, negative on the inner side of its plane,
-  // and its normal (false when there is none).
+  // and its normal (false when there is none). `hint`: a triangle likely nearest (one a query of a
+  // point nearby found), measured first so that the search skips every box farther than it; the
+  // same distance comes out.
   bool distance(const double p[3], double reach, double& distance, double normal[3], int* triangle = nullptr,
-                const double* facing = nullptr) const;
+                const double* facing = nullptr, int hint = -1) const;
 };
 
 namespace quiver::rt {
