@@ -194,6 +194,36 @@ TEST(TriangleMesh, ANonConvexStarHasTheWindingNumbersSign) {
   EXPECT_LT(inside, 1400);
 }
 
+// A hint (a triangle measured first, so that the search skips what lies farther) changes nothing
+// but the work: on the bumpy star, any hint, near or far, and facing or not, gives the distance
+// and sign the search alone gives, bit for bit, and a hint out of range is ignored.
+TEST(TriangleMesh, AHintChangesNothingButTheWork) {
+  const auto radius = [](const Eigen::Vector3d& d) { return 1 + 0.4 * std::sin(5 * d[0]) * std::cos(4 * d[1]) * std::sin(3 * d[2] + 1); };
+  const Surface s = sphere(24, 48, radius);
+  Mesh m(s);
+  ASSERT_EQ(m.result, QV_OK) << m.message;
+  const int triangles = static_cast<int>(s.triangles.size() / 3);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1.5, 1.5), nudge(-0.02, 0.02);
+  std::uniform_int_distribution<int> any(0, triangles - 1);
+  const double up[3] = {0, 0, 1};
+  for (int i = 0; i < 3000; ++i) {
+    const Eigen::Vector3d p(u(rng), u(rng), u(rng)), near = p + Eigen::Vector3d(nudge(rng), nudge(rng), nudge(rng));
+    const double* facing = i % 3 == 0 ? up : nullptr;
+    double d, n[3];
+    int t = -1;
+    if (!m.mesh->distance(p.data(), INFINITY, d, n, &t, facing)) continue;
+    int nearT = -1;
+    double unused, un[3];
+    m.mesh->distance(near.data(), INFINITY, unused, un, &nearT, facing);  // what a query nearby finds
+    for (const int hint : {t, nearT, any(rng), -1, triangles}) {
+      double dh, nh[3];
+      ASSERT_TRUE(m.mesh->distance(p.data(), INFINITY, dh, nh, nullptr, facing, hint));
+      ASSERT_EQ(dh, d) << "at " << p.transpose() << " with hint " << hint;
+    }
+  }
+}
+
 TEST(TriangleMesh, ANeedlesTipIsOnTheRightSide) {
   // Around a sharp tip the closest point is the tip for points on every side, and one face's normal
   // alone gives the wrong sign for half of them: the angle-weighted vertex normal decides.
