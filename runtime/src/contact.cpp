@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "c_enum.h"
+#include "jobs.h"
 #include "triangle_mesh.h"
 #include "vec3.h"
 
@@ -1084,13 +1085,7 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
           static_cast<long long>(bodies[i].islandFirst) * jobCount / list.count == job)
         sweepIsland(bodies[i]);
   };
-  if (jobCount > 1) {
-    using Job = decltype(sweepJob);
-    jobs->run(jobs->user, [](void* data, int job) { (*static_cast<const Job*>(data))(job); },
-              const_cast<void*>(static_cast<const void*>(&sweepJob)), jobCount);
-  } else {
-    sweepJob(0);
-  }
+  runJobs(jobs, jobCount, sweepJob);
   for (int i = 0; i < bodyCount; ++i) {
     std::memcpy(bodies[i].instance->frame.velocity, bodies[i].velocity, sizeof bodies[i].velocity);
     if (bodies[i].modesPredicted) bodies[i].instance->softContact = true;

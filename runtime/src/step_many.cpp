@@ -6,6 +6,7 @@
 #include "cholesky_lanes.h"
 #include "dense_solve.h"
 #include "dynamics.h"
+#include "jobs.h"
 #include "simd_dispatch.h"
 #include "integrators/integrator.h"
 
@@ -316,34 +317,20 @@ void stepRange(qv_instance* const* instances, int first, int last, double* scrat
   stepMinimizingTogether(instances, next, scratch, statuses);
 }
 
-struct Work {
-  qv_instance* const* instances;
-  int count;
-  int jobs;
-  char* scratch;
-  qv_step_status* statuses;
-};
-
-void runJob(void* data, int job) {
-  const Work& w = *static_cast<const Work*>(data);
-  if (job < 0 || job >= w.jobs) return;
-  // Cut on multiples of a group, so that a crowd of groupable instances forms the same groups, and
-  // so the same bits, whatever the number of jobs.
-  const long long groups = (w.count + kLanes - 1) / kLanes;
-  const auto bound = [&](int j) { return static_cast<int>(std::min<long long>(w.count, groups * j / w.jobs * kLanes)); };
-  const size_t perJob = stepManyScratchPerJob(*w.instances[0]->model);
-  stepRange(w.instances, bound(job), bound(job + 1), reinterpret_cast<double*>(w.scratch + perJob * job), w.statuses);
-}
-
 } // namespace
 
 void stepMany(qv_instance* const* instances, int count, const qv_job_runner* runner, void* scratch,
               qv_step_status* statuses) {
-  Work work{instances, count, runner ? runner->count : 1, static_cast<char*>(scratch), statuses};
-  if (runner)
-    runner->run(runner->user, runJob, &work, work.jobs);
-  else
-    runJob(&work, 0);
+  const int jobs = runner ? runner->count : 1;
+  // Cut on multiples of a group, so that a crowd of groupable instances forms the same groups, and
+  // so the same bits, whatever the number of jobs.
+  const long long groups = (count + kLanes - 1) / kLanes;
+  const auto bound = [&](int j) { return static_cast<int>(std::min<long long>(count, groups * j / jobs * kLanes)); };
+  const size_t perJob = stepManyScratchPerJob(*instances[0]->model);
+  runJobs(runner, jobs, [&](int job) {
+    stepRange(instances, bound(job), bound(job + 1), reinterpret_cast<double*>(static_cast<char*>(scratch) + perJob * job),
+              statuses);
+  });
 }
 
 } // namespace quiver::rt

@@ -6,6 +6,7 @@
 
 #include "block_carver.h"
 #include "elasticity.h"
+#include "jobs.h"
 
 namespace quiver::rt {
 
@@ -108,24 +109,12 @@ void destroyWorld(qv_world* world) {
 } // namespace quiver::rt
 
 void qv_world::forEachInstance(void (*part)(qv_world&, int)) {
-  struct Work {
-    qv_world* world;
-    void (*part)(qv_world&, int);
-    int jobs;
-  } work{this, part, jobs ? jobs->count : 1};
-  const auto runJob = [](void* data, int job) {
-    const Work& w = *static_cast<const Work*>(data);
-    if (job < 0 || job >= w.jobs) return;
-    const int n = w.world->count;
-    const int first = static_cast<int>(static_cast<long long>(n) * job / w.jobs);
-    const int end = static_cast<int>(static_cast<long long>(n) * (job + 1) / w.jobs);
-    for (int i = first; i < end; ++i) w.part(*w.world, i);
-  };
-  if (work.jobs > 1) {
-    jobs->run(jobs->user, runJob, &work, work.jobs);
-  } else {
-    runJob(&work, 0);
-  }
+  const int jobCount = jobs ? jobs->count : 1;
+  quiver::rt::runJobs(jobs, jobCount, [&](int job) {
+    const int first = static_cast<int>(static_cast<long long>(count) * job / jobCount);
+    const int end = static_cast<int>(static_cast<long long>(count) * (job + 1) / jobCount);
+    for (int i = first; i < end; ++i) part(*this, i);
+  });
 }
 
 int qv_world::step() {
