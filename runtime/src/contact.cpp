@@ -591,7 +591,7 @@ void findBodyContacts(ContactBody* bodies, int i, int j, double h, const Contact
     int otherVertex = 0;
     surfacePoint(a, n, softA, p);
     const double reach = keptReach(list, margin, a.contactSlop);
-    int nearest = 0, facingNearest = 0;  // the triangles the queries found: hints for the deformed vertex's
+    int nearest = 0, facingNearest = 0;  // the triangles the queries found: hints for the deformed vertex
     if (!bodyDistance(b, p, reach, depth, normal, &otherVertex, nullptr, &nearest) || depth > reach) continue;
     const double arm = distance3(p, a.frame.position);
     // b's rest surface stays within its radius of b's centre; a's vertex closes on that centre by
