@@ -960,6 +960,98 @@ TEST(World, StepsInJobsGiveTheSameBits) {
   EXPECT_EQ(qv_world_set_jobs(world.w, nullptr), QV_OK);  // back to the calling thread
 }
 
+// What a game does to a world, at random, 3000 times: steps (most often), adds and removes bars,
+// wakes and moves them, sets jobs and clears them, saves and restores snapshots. The bookkeeping
+// stays whole after each: every member is finite; the contacts name members only; a snapshot of
+// the world restores (its checks refuse sleep groups and contacts that name no member); a removed
+// bar is awake and steps alone.
+TEST(World, RandomAddsRemovesWakesAndStepsKeepItsBookkeepingWhole) {
+  FreeBar bar(10, {6, 1, 1});
+  const double h = 1.0 / 60;
+  qv_world_config c;
+  qv_world_config_init(&c);
+  c.max_instances = 8;
+  c.sleep_time = 0.1;  // sleeping and waking often
+  World world;
+  qv_world_destroy(world.w);
+  ASSERT_EQ(qv_world_create(&c, nullptr, &world.w), QV_OK);
+  world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0)};
+  world.setColliders();
+  struct Backwards {
+    static void run(void*, qv_job_function job, void* data, int count) {
+      for (int i = count - 1; i >= 0; --i) job(data, i);
+    }
+  };
+  const qv_job_runner jobs{3, Backwards::run, nullptr};
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> where(-0.3, 0.3), high(0.06, 0.3);
+  const auto dropped = [&] { return at(where(rng), where(rng), high(rng)); };
+  std::vector<qv_instance*> members, out;
+  for (int k = 0; k < 8; ++k) {
+    qv_instance* s = world.add(bar, h, dropped(), true);
+    if (k < 5) {
+      members.push_back(s);
+    } else {
+      ASSERT_EQ(qv_world_remove(world.w, s), QV_OK);
+      out.push_back(s);
+    }
+  }
+  std::uniform_int_distribution<int> action(0, 199);  // mostly steps, so that groups come to rest and sleep
+  int steps = 0, removed = 0, added = 0, restored = 0, slept = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const int a = action(rng);
+    const auto pick = [&](std::vector<qv_instance*>& from) {
+      return static_cast<size_t>(std::uniform_int_distribution<int>(0, static_cast<int>(from.size()) - 1)(rng));
+    };
+    if (a <= 2 && !members.empty()) {  // despawn
+      const size_t k = pick(members);
+      ASSERT_EQ(qv_world_remove(world.w, members[k]), QV_OK);
+      EXPECT_EQ(qv_instance_asleep(members[k]), 0);
+      ASSERT_NE(qv_instance_step(members[k]), QV_STEP_RESET);
+      out.push_back(members[k]);
+      members.erase(members.begin() + static_cast<long>(k));
+      ++removed;
+    } else if (a >= 3 && a <= 5 && !out.empty()) {  // spawn again, somewhere above
+      const size_t k = pick(out);
+      const qv_rigid_state s = dropped();
+      ASSERT_EQ(qv_instance_set_rigid_state(out[k], &s), QV_OK);
+      int index = -1;
+      ASSERT_EQ(qv_world_add(world.w, out[k], &index), QV_OK);
+      EXPECT_EQ(index, static_cast<int>(members.size()));
+      members.push_back(out[k]);
+      out.erase(out.begin() + static_cast<long>(k));
+      ++added;
+    } else if (a == 6 && !members.empty()) {
+      qv_instance_wake(members[pick(members)]);
+    } else if (a == 7 && !members.empty()) {  // the game moves one
+      const qv_rigid_state s = dropped();
+      ASSERT_EQ(qv_instance_set_rigid_state(members[pick(members)], &s), QV_OK);
+    } else if (a == 8) {
+      ASSERT_EQ(qv_world_set_jobs(world.w, i % 2 ? &jobs : nullptr), QV_OK);
+    } else {
+      ASSERT_EQ(qv_world_step(world.w), 0);
+      ++steps;
+    }
+    for (qv_instance* s : members) ASSERT_TRUE(bar.positions(s).allFinite()) << "action " << i;
+    for (const qv_contact& ct : world.contacts()) {
+      ASSERT_LT(ct.instance, static_cast<int>(members.size())) << "action " << i;
+      ASSERT_LT(ct.other, static_cast<int>(members.size())) << "action " << i;
+    }
+    std::vector<double> snapshot(qv_world_snapshot_size(world.w) / sizeof(double) + 1);
+    const size_t used = qv_world_save_snapshot(world.w, snapshot.data());
+    ASSERT_EQ(qv_world_restore_snapshot(world.w, snapshot.data(), used), QV_OK) << "action " << i;
+    ++restored;
+    int sleeping = 0;
+    for (qv_instance* s : members) sleeping += qv_instance_asleep(s);
+    slept = std::max(slept, sleeping);
+  }
+  std::printf("3000 random actions: %d steps, %d removals, %d additions, %d snapshots restored; up to %d asleep at once\n", steps,
+              removed, added, restored, slept);
+  EXPECT_GT(removed, 10);
+  EXPECT_GT(added, 10);
+  EXPECT_GT(slept, 1);
+}
+
 TEST(World, BadUseIsRefused) {
   FreeBar bar;
   World world;
