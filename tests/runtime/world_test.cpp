@@ -36,14 +36,17 @@ struct World {
   std::vector<std::unique_ptr<test::Instance>> bodies;
   std::vector<qv_collider> colliders;
   // Sleeping off unless asked for: most tests here watch contacts at rest.
-  explicit World(double friction = 0.5, double restitution = 0, int maxContacts = 4096, double sleepSpeed = 0) {
+  explicit World(double friction = 0.5, double restitution = 0, int maxContacts = 4096, double sleepSpeed = 0)
+      : World(config(friction, restitution, maxContacts, sleepSpeed)) {}
+  explicit World(const qv_world_config& c) { EXPECT_EQ(qv_world_create(&c, nullptr, &w), QV_OK); }
+  static qv_world_config config(double friction, double restitution, int maxContacts, double sleepSpeed) {
     qv_world_config c;
     qv_world_config_init(&c);
     c.friction = friction;
     c.restitution = restitution;
     c.max_contacts = maxContacts;
     c.sleep_speed = sleepSpeed;
-    EXPECT_EQ(qv_world_create(&c, nullptr, &w), QV_OK);
+    return c;
   }
   ~World() { qv_world_destroy(w); }
   qv_instance* add(const FreeBar& bar, double h, const qv_rigid_state& start, bool gravity, bool softContacts = false) {
@@ -67,6 +70,11 @@ struct World {
 };
 
 qv_rigid_state at(double x, double y, double z, double vx = 0) { return {{x, y, z}, {1, 0, 0, 0}, {vx, 0, 0}, {0, 0, 0}}; }
+
+// A job runner that runs a world's jobs backwards on the calling thread (qv_world_set_jobs).
+void runBackwards(void*, qv_job_function job, void* data, int count) {
+  for (int i = count - 1; i >= 0; --i) job(data, i);
+}
 
 TEST(World, InAStackTheGroundCarriesBothAndTheLowerBarTheUpper) {
   FreeBar bar(16, {12, 2, 2});
@@ -665,12 +673,9 @@ TEST(World, RemovingABodyLeavesTheOthersAsIfItHadNeverBeen) {
 TEST(World, WithNoSleepTimeABarSleepsOnlyOnceItIsStill) {
   FreeBar bar(16, {12, 2, 2});
   const double h = 1.0 / 60;
-  qv_world_config c;
-  qv_world_config_init(&c);
+  qv_world_config c = World::config(0.5, 0, 4096, kSleepSpeed);
   c.sleep_time = 0;
-  World world(0.5, 0, 4096, kSleepSpeed);
-  qv_world_destroy(world.w);
-  ASSERT_EQ(qv_world_create(&c, nullptr, &world.w), QV_OK);
+  World world(c);
   world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0)};
   world.setColliders();
   qv_instance* s = world.add(bar, h, at(0.3, 0.05, 0.5), true);
@@ -897,11 +902,6 @@ TEST(World, WithSoftContactsASoftBarLiesStraightOnASlab) {
 TEST(World, StepsInJobsGiveTheSameBits) {
   FreeBar bar(16, {12, 2, 2});
   const double h = 1.0 / 60;
-  struct Backwards {
-    static void run(void*, qv_job_function job, void* data, int count) {
-      for (int i = count - 1; i >= 0; --i) job(data, i);
-    }
-  };
   struct Threads {
     static void run(void*, qv_job_function job, void* data, int count) {
       std::vector<std::thread> others;
@@ -910,7 +910,7 @@ TEST(World, StepsInJobsGiveTheSameBits) {
       for (std::thread& t : others) t.join();
     }
   };
-  const qv_job_runner backwards{3, Backwards::run, nullptr}, threads{2, Threads::run, nullptr};
+  const qv_job_runner backwards{3, runBackwards, nullptr}, threads{2, Threads::run, nullptr};
   const auto dropApart = [&](World& world) {
     world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0)};
     world.setColliders();
@@ -952,7 +952,7 @@ TEST(World, StepsInJobsGiveTheSameBits) {
     EXPECT_GT(asleep(one), 0);
   }
   World world;
-  const qv_job_runner none{0, Backwards::run, nullptr}, runless{2, nullptr, nullptr};
+  const qv_job_runner none{0, runBackwards, nullptr}, runless{2, nullptr, nullptr};
   EXPECT_EQ(qv_world_set_jobs(world.w, &none), QV_ERROR_INVALID_ARGUMENT);
   EXPECT_EQ(qv_world_set_jobs(world.w, &runless), QV_ERROR_INVALID_ARGUMENT);
   EXPECT_EQ(qv_world_set_jobs(nullptr, &threads), QV_ERROR_INVALID_ARGUMENT);
@@ -972,17 +972,10 @@ TEST(World, RandomAddsRemovesWakesAndStepsKeepItsBookkeepingWhole) {
   qv_world_config_init(&c);
   c.max_instances = 8;
   c.sleep_time = 0.1;  // sleeping and waking often
-  World world;
-  qv_world_destroy(world.w);
-  ASSERT_EQ(qv_world_create(&c, nullptr, &world.w), QV_OK);
+  World world(c);
   world.colliders = {makeCollider(QV_COLLIDER_PLANE, {0, 0, 1, 0, 0, 0, 0, 0}, 0.5, 0)};
   world.setColliders();
-  struct Backwards {
-    static void run(void*, qv_job_function job, void* data, int count) {
-      for (int i = count - 1; i >= 0; --i) job(data, i);
-    }
-  };
-  const qv_job_runner jobs{3, Backwards::run, nullptr};
+  const qv_job_runner jobs{3, runBackwards, nullptr};
   std::mt19937 rng(21);
   std::uniform_real_distribution<double> where(-0.3, 0.3), high(0.06, 0.3);
   const auto dropped = [&] { return at(where(rng), where(rng), high(rng)); };
