@@ -570,7 +570,8 @@ steps every awake instance once and returns how many reset. The world keeps its 
         return qv_world_step(world);
       }, py::arg("threads") = 1,
            "Steps every awake instance once; returns how many reset (never expected). threads > 1 runs each "
-           "instance's own parts of the step on that many threads (made for the call; the same bits).")
+           "instance's own parts of the step and the contact solve's islands on that many threads (made for the "
+           "call; the same bits).")
       .def("contacts", [](const World& self) { return contactArray(static_cast<const qv_world*>(self.use()), qv_world_contacts); },
            "The last step's contacts, as Instance.contacts(); `instance` and `other` say who touched whom.")
       .def("save_snapshot", [](const World& self) {

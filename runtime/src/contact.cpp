@@ -134,8 +134,13 @@ void bodyPointVelocity(const ContactBody& b, const double a[3], double out[3]) {
   for (int k = 0; k < 3; ++k) out[k] = b.velocity[k] + wa[k];
 }
 
-// The impulse J = sum_k lambda_k d_k along the contact's directions (normal, tangents), times sign,
-// on a body's velocity and spin; `turns`: the turnPerImpulse() of each direction at its arm.
+// The impulse J = sum_k lambda_k d_k along a contact's directions (normal, tangent 0, tangent 1).
+void impulseAlong(const Contact& ct, const double lambda[3], double J[3]) {
+  for (int a = 0; a < 3; ++a) J[a] = lambda[0] * ct.normal[a] + lambda[1] * ct.tangent[0][a] + lambda[2] * ct.tangent[1][a];
+}
+
+// That impulse (impulseAlong()), times sign, on a body's velocity and spin; `turns`: the
+// turnPerImpulse() of each direction at its arm.
 void applyImpulse(ContactBody& b, const double turns[3][3], const double lambda[3], const double J[3], double sign) {
   for (int k = 0; k < 3; ++k) {
     b.velocity[k] += sign * b.inverseMass * J[k];
@@ -938,7 +943,7 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
     const Contact& ct = list.contacts[j];
     const ContactTurns& turns = list.turns[j];
     double J[3];
-    for (int a = 0; a < 3; ++a) J[a] = lambda[0] * ct.normal[a] + lambda[1] * ct.tangent[0][a] + lambda[2] * ct.tangent[1][a];
+    impulseAlong(ct, lambda, J);
     applyImpulse(bodies[ct.body], turns.body, lambda, J, 1);
     if (ct.other >= 0) applyImpulse(bodies[ct.other], turns.other, lambda, J, -1);
     if (ct.rows) pushModes(*bodies[ct.body].instance, ct.rows, J, 1);
@@ -1076,53 +1081,42 @@ void solveContacts(ContactBody* bodies, int bodyCount, const qv_collider* collid
   };
   // Islands touch no body in common, so they are swept in the caller's jobs (contiguous shares of
   // the contacts, whole islands each) with the same bits; one island (a pile) on the calling thread.
+  const auto heldIsland = [&](int i) { return bodies[i].island == i && bodies[i].islandEnd > bodies[i].islandFirst; };
   int islands = 0;
-  for (int i = 0; i < bodyCount && islands < 2; ++i) islands += bodies[i].island == i && bodies[i].islandEnd > bodies[i].islandFirst;
+  for (int i = 0; i < bodyCount && islands < 2; ++i) islands += heldIsland(i);
   const int jobCount = jobs && islands > 1 ? jobs->count : 1;
   const auto sweepJob = [&](int job) {
     for (int i = 0; i < bodyCount; ++i)
-      if (bodies[i].island == i && bodies[i].islandEnd > bodies[i].islandFirst &&
-          static_cast<long long>(bodies[i].islandFirst) * jobCount / list.count == job)
-        sweepIsland(bodies[i]);
+      if (heldIsland(i) && static_cast<long long>(bodies[i].islandFirst) * jobCount / list.count == job) sweepIsland(bodies[i]);
   };
   runJobs(jobs, jobCount, sweepJob);
   for (int i = 0; i < bodyCount; ++i) {
     std::memcpy(bodies[i].instance->frame.velocity, bodies[i].velocity, sizeof bodies[i].velocity);
     if (bodies[i].modesPredicted) bodies[i].instance->softContact = true;
   }
-  // The angular momenta the impulses add, a x J for each contact's whole impulse (the solve steps
-  // the spin alone).
+  // Each contact's whole impulse adds its angular momenta, a x J (the solve stepped the spin alone),
+  // and over the step loads the deformations where it acts, less the bounce: the restitution
+  // already returns that energy to the frames, and loading q with it too would make energy.
   for (int j = 0; j < list.count; ++j) {
     const Contact& ct = list.contacts[j];
-    double J[3], turn[3];
-    for (int a = 0; a < 3; ++a)
-      J[a] = ct.normalImpulse * ct.normal[a] + ct.tangentImpulse[0] * ct.tangent[0][a] + ct.tangentImpulse[1] * ct.tangent[1][a];
-    cross3(ct.arm, J, turn);
-    double* L = bodies[ct.body].instance->frame.angularMomentum;
-    for (int a = 0; a < 3; ++a) L[a] += turn[a];
-    if (ct.other < 0) continue;
-    cross3(ct.otherArm, J, turn);
-    L = bodies[ct.other].instance->frame.angularMomentum;
-    for (int a = 0; a < 3; ++a) L[a] -= turn[a];
-  }
-  // The same impulses over the step load the deformations where they act, less the bounce: the
-  // restitution already returns that energy to the frames, and loading q with it too would make energy.
-  for (int j = 0; j < list.count; ++j) {
-    const Contact& ct = list.contacts[j];
-    const double normal = ct.bounce > 0 ? std::fmin(ct.normalImpulse, ct.stopImpulse) : ct.normalImpulse;
-    double world[3];
-    for (int a = 0; a < 3; ++a)
-      world[a] = (normal * ct.normal[a] + ct.tangentImpulse[0] * ct.tangent[0][a] + ct.tangentImpulse[1] * ct.tangent[1][a]) / h;
-    const auto load = [&](int body, int vertex, double sign) {
+    const double whole[3] = {ct.normalImpulse, ct.tangentImpulse[0], ct.tangentImpulse[1]};
+    const double loaded[3] = {ct.bounce > 0 ? std::fmin(ct.normalImpulse, ct.stopImpulse) : ct.normalImpulse,
+                              ct.tangentImpulse[0], ct.tangentImpulse[1]};
+    double J[3], world[3];
+    impulseAlong(ct, whole, J);
+    impulseAlong(ct, loaded, world);
+    for (int a = 0; a < 3; ++a) world[a] /= h;
+    const auto act = [&](int body, const double arm[3], int vertex, double sign) {
       qv_instance& s = *bodies[body].instance;
-      double force[3], local[3];
-      for (int a = 0; a < 3; ++a) force[a] = sign * world[a];
+      double turn[3], force[3], local[3];
+      cross3(arm, J, turn);
+      for (int a = 0; a < 3; ++a) s.frame.angularMomentum[a] += sign * turn[a], force[a] = sign * world[a];
       s.frame.toBody(force, local);
       s.loads.addVertexForce(*s.model, s.config.elasticity, s.q, vertex, local);
+      s.touching = true;
     };
-    load(ct.body, ct.vertex, 1);
-    bodies[ct.body].instance->touching = true;
-    if (ct.other >= 0) load(ct.other, ct.otherVertex, -1), bodies[ct.other].instance->touching = true;
+    act(ct.body, ct.arm, ct.vertex, 1);
+    if (ct.other >= 0) act(ct.other, ct.otherArm, ct.otherVertex, -1);
   }
 }
 
