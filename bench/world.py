@@ -44,7 +44,7 @@ def main():
     ap.add_argument("--contacts", default="rigid,soft", help="comma-separated: rigid (the default contacts), soft")
     ap.add_argument("--against", help="another build's quiver binary: compare the two (see above)")
     ap.add_argument("--threads", type=int, help="compare one thread against this many (see above)")
-    ap.add_argument("--runs", type=int, default=3, help="with --against: alternated runs of each")
+    ap.add_argument("--runs", type=int, default=3, help="with --against or --threads: alternated runs of each")
     ap.add_argument("--steps", type=int, default=STEPS, help="steps of 1/60 s a run")
     args = ap.parse_args()
     if args.against and args.threads:
@@ -71,14 +71,9 @@ def main():
             for contacts in args.contacts.split(","):
                 for sleep in ("0", "0.02"):
                     soft = ["--soft-contacts"] if contacts == "soft" else []
-                    sim = subprocess.run([os.path.join(apps, "quiver"), "sim", bar + ".qvr", "--free", "--gravity", "--pile", str(n),
-                                          *layout, *soft, "--position", "0,0,0.2", "--collider", "plane:0,0,1,0",
-                                          "--steps", str(args.steps), "--sleep-speed", sleep, "--json"],
-                                         capture_output=True, text=True, stdin=subprocess.DEVNULL)
-                    if sim.returncode not in (0, 2):  # 2: some step reset, which the table counts
-                        raise SystemExit(f"quiver sim --pile {n} failed ({sim.returncode}): {sim.stderr.strip()}")
-                    rows.append((f"{n} apart" if layout else str(n), contacts, "off" if sleep == "0" else f"{sleep} m/s",
-                                 json.loads(sim.stdout)))
+                    j = simulate(quiver, bar + ".qvr", ["--pile", str(n), *layout, *soft, "--sleep-speed", sleep], args.steps,
+                                 f"quiver sim --pile {n}")
+                    rows.append((f"{n} apart" if layout else str(n), contacts, "off" if sleep == "0" else f"{sleep} m/s", j))
     print(machine_line() + f"; one thread, {args.steps} steps of 1/60 s\n")
     print("| bodies | contacts | sleeping | world step, median (ms) | 99th percentile (ms) | median per body (us) "
           "| asleep at the end | fastest body at the end (m/s) | deepest deformed-vertex penetration (mm) | resets |")
@@ -88,6 +83,17 @@ def main():
         print(f"| {n} | {contacts} | {sleep} | {j['step_us_median'] / 1e3:.2f} | {j['step_us_p99'] / 1e3:.1f} | {j['step_us_median'] / bodies:.1f} "
               f"| {j['asleep_at_end']} | {j['max_final_speed_mps']:.1g} "
               f"| {j['max_penetration_m'] * 1e3:.0f} | {j['resets']} |")
+
+
+def simulate(quiver, model, options, steps, what):
+    """`quiver sim` of the bar dropped onto the ground with `options`, its JSON; exit code 2 (some
+    step reset) is a result, which the tables count."""
+    sim = subprocess.run([quiver, "sim", model, "--free", "--gravity", *options, "--position", "0,0,0.2",
+                          "--collider", "plane:0,0,1,0", "--steps", str(steps), "--json"],
+                         capture_output=True, text=True, stdin=subprocess.DEVNULL)
+    if sim.returncode not in (0, 2):
+        raise SystemExit(f"{what} failed ({sim.returncode}): {sim.stderr.strip()}")
+    return json.loads(sim.stdout)
 
 
 def compare(args, model, worlds, sides):
@@ -109,12 +115,7 @@ def compare(args, model, worlds, sides):
         times = [[], []]
         for _ in range(args.runs):
             for k, (label, binary, extra) in enumerate(sides):
-                sim = subprocess.run([binary, "sim", model, "--free", "--gravity", *options, *extra, "--position", "0,0,0.2",
-                                      "--collider", "plane:0,0,1,0", "--steps", str(args.steps), "--json"],
-                                     capture_output=True, text=True, stdin=subprocess.DEVNULL)
-                if sim.returncode not in (0, 2):
-                    raise SystemExit(f"{label} sim ({name}) failed ({sim.returncode}): {sim.stderr.strip()}")
-                times[k].append(json.loads(sim.stdout)["step_us_median"] / 1e3)
+                times[k].append(simulate(binary, model, options + extra, args.steps, f"{label} sim ({name})")["step_us_median"] / 1e3)
         before, after = statistics.median(times[0]), statistics.median(times[1])
         print(f"| {name} | {before:.3f} | {after:.3f} | {after / before:.2f} |")
 
