@@ -170,6 +170,10 @@ def test_a_world_stacks_one_beam_on_another(free_model):
     low.step()  # alone now
     with pytest.raises(ValueError, match="not in this World"):
         world.remove(low)
+    with pytest.raises(TypeError, match="takes a quiver.Instance"):
+        world.remove("low")
+    with pytest.raises(ValueError, match="threads must be at least 1"):
+        world.step(threads=0)
     assert world.add(low) == 1
     with pytest.raises(ValueError, match="is in a World"):
         quiver.step_many([low])
